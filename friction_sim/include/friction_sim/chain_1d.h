@@ -1,0 +1,64 @@
+// The 1D chain of MODEL.md §3: N blocks along x joined by springs k = E·H·B/a with neighbour damping
+// η, driven at the side (pusher K on block 0) or from the top (K/N on every block). The normal force
+// per block is w_i = (F_Z/N)(1 + θξ_i) + c·ξ_i with ξ_i = 2X_i/L − 1 and the friction-induced torque
+// c = 2·g·h·F_X/(L·Σξ²). With one block it is the single block on a spring.
+#pragma once
+
+#include <vector>
+
+#include "friction_sim/model.h"
+
+namespace friction {
+
+class Chain1D : public Model {
+ public:
+  explicit Chain1D(const Scene& scene);
+
+  double springStiffness() const { return k_; }  ///< N/m, k (0 for a single block)
+  double dampingRate() const { return eta_; }    ///< kg/s, η
+  double spacing() const { return spacing_; }    ///< m, a
+
+  /// N, the normal force on every block for a given pusher force F_X.
+  std::vector<double> normalForces(double shear_force) const;
+
+  int dofCount() const override { return n_; }
+  double nodeMass() const override { return mass_; }
+  int interfaceNodeCount() const override { return n_; }
+  int interfaceDof(int node) const override { return node; }
+  double interfacePosition(int node) const override { return node * spacing_; }
+  double interfaceNodeArea() const override { return area_per_block_; }
+
+  void evaluate(const Vector& u, const Vector& v, double stage_position,
+                ForceEvaluation& out) const override;
+  double elasticEnergy(const Vector& u, double stage_position) const override;
+  double externalWork(const Vector&, const Vector&) const override { return 0.0; }
+  SparseMatrix stiffnessMatrix() const override;
+  SparseMatrix dampingMatrix() const override;
+  std::vector<int> blockedDofsDuringLoading() const override;
+  Vector initialBodyForce() const override;
+  void disconnectPusher() override { pusher_connected_ = false; }
+  void connectPusher(const Vector& u) override;
+  void setNormalLoad(double normal_force) override { normal_force_ = normal_force; }
+  GaugeStresses gaugeStresses(const Vector&, double, const std::vector<double>&) const override {
+    return {};  // the chain has no vertical dimension: the interface frame is its only stress reading
+  }
+  void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const override;
+
+ private:
+  double drivingStiffness(int block) const;
+
+  int n_;
+  double length_, spacing_, mass_, k_, eta_, area_per_block_;
+  bool top_driving_;
+  double pusher_k_;
+  double pushing_height_;
+  double tilt_, torque_share_;
+  double normal_force_;
+  std::vector<double> xi_;
+  double xi_square_sum_;
+  std::vector<double> initial_shear_;
+  std::vector<double> pusher_offset_;
+  bool pusher_connected_ = true;
+};
+
+}  // namespace friction

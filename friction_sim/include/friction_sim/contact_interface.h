@@ -1,0 +1,82 @@
+// The stick/slip rules of MODEL.md §4, written once for every friction law:
+//  - stuck: the node holds (rigidly, or through the interfacial spring k_T to its anchor) as long as the
+//    force needed stays within µ_s·N;
+//  - unstick: at the end of a step where the force needed exceeds µ_s·N; the node then slides in the
+//    direction of that force;
+//  - sliding: f = −µ·N·sgn(v) with µ from the law, the direction fixed at the start of the step;
+//  - re-stick: when the velocity passes through zero within a step; the node stops at the interpolated
+//    zero crossing, not a step late. A node that has just unstuck cannot re-stick in the same step;
+//  - loss of contact: with N = 0 the node is detached and carries no friction; it slides (or sticks, if
+//    at rest) again when contact returns.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "friction_sim/friction_law.h"
+#include "friction_sim/model.h"
+
+namespace friction {
+
+enum class ContactState : std::uint8_t { Stuck = 0, Sliding = 1, Detached = 2 };
+
+class ContactInterface {
+ public:
+  /// `tangential_stiffness` is k_T (N/m); 0 makes stuck nodes rigid.
+  ContactInterface(std::unique_ptr<FrictionLaw> law, const Model& model, double tangential_stiffness);
+
+  /// Sticks every node where it is, with no stored interfacial shear and slip measured from here.
+  void reset(const Vector& u);
+
+  /// Adds the friction forces to `force`, which holds every other force on the degrees of freedom.
+  void applyFriction(const ForceEvaluation& raw, const Vector& u, Vector& force);
+
+  /// Remembers the interface at the start of a step.
+  void beginStep(const Vector& u, const Vector& v);
+  /// After the integrator's step: stops nodes whose velocity passed through zero at the interpolated
+  /// crossing, accounts friction dissipation and slip. Returns true if any node re-stuck.
+  bool finishStep(Vector& u, Vector& v, double dt);
+  /// After the last force evaluation of a step: loss and return of contact, unsticking. Returns true
+  /// if any node changed state (its friction must then be re-applied).
+  bool updateStates(const ForceEvaluation& raw, const Vector& u, const Vector& v);
+
+  int size() const { return static_cast<int>(state_.size()); }
+  ContactState state(int node) const { return state_[node]; }
+  int slidingCount() const;
+  double frictionForce(int node) const { return friction_[node]; }  ///< N, track on slider, x
+  double normalForce(int node) const { return normal_[node]; }      ///< N
+  double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m
+  /// Nodes that unstuck (or slid off on returning contact) at the end of the last step.
+  const std::vector<int>& unstuckLastStep() const { return unstuck_last_step_; }
+  /// J, energy dissipated by friction since reset (includes energy released by k_T anchors).
+  double frictionDissipation() const { return dissipation_; }
+  /// J, energy stored in the k_T anchor springs.
+  double anchorEnergy(const Vector& u) const;
+  double tangentialStiffness() const { return k_t_; }
+  const FrictionLaw& law() const { return *law_; }
+  const std::vector<int>& dofs() const { return dofs_; }
+
+ private:
+  void stick(int node, const Vector& u);
+  void startSliding(int node, int direction);
+
+  std::unique_ptr<FrictionLaw> law_;
+  std::vector<int> dofs_;
+  double k_t_;
+  std::vector<ContactState> state_;
+  std::vector<int> direction_;       ///< ±1, sliding direction
+  std::vector<double> anchor_;       ///< m, where a stuck node is held
+  std::vector<double> friction_;     ///< N
+  std::vector<double> normal_;       ///< N
+  std::vector<double> other_force_;  ///< N, tangential force on the node from everything but friction
+  std::vector<double> slip_origin_;  ///< m
+  std::vector<char> just_unstuck_;
+  std::vector<int> unstuck_last_step_;
+  // Start-of-step copies for re-stick interpolation and dissipation.
+  std::vector<double> start_u_, start_v_, start_friction_;
+  std::vector<ContactState> start_state_;
+  double dissipation_ = 0.0;
+};
+
+}  // namespace friction

@@ -1,0 +1,58 @@
+// What the rig's instruments report (MODEL.md §6), as plain structs the nodes turn into messages.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "friction_sim/model.h"
+
+namespace friction {
+
+/// Load cells and counters at one instant.
+struct LoadCellReading {
+  double time = 0.0;                  ///< s, simulated
+  double stage_position = 0.0;        ///< m, X_s
+  double shear_force = 0.0;           ///< N, F_X on the pusher
+  double normal_force = 0.0;          ///< N, F_Z on the top face (positive pressing down)
+  double interface_normal_sum = 0.0;  ///< N, Σ N_i measured at the interface
+  int sliding_nodes = 0;              ///< N_sliding
+};
+
+/// The fast camera's frame: the interface's state per node.
+struct InterfaceFrame {
+  double time = 0.0;               ///< s
+  std::vector<double> position;    ///< m, rest x of each interface node
+  std::vector<std::uint8_t> state;  ///< 0 stuck, 1 sliding, 2 detached (contact lost)
+  std::vector<double> slip_velocity;  ///< m/s, dx/dt
+  std::vector<double> slip;           ///< m, accumulated since the run started
+  std::vector<double> normal_force;   ///< N, N_i
+  std::vector<double> friction_force;  ///< N, f_i, x force of the track on the slider
+  std::vector<double> normal_stress;   ///< Pa, σ_i = N_i/(l·B), positive in compression
+  std::vector<double> shear_stress;    ///< Pa, τ_i = −f_i/(l·B), positive when resisting a push in +x
+};
+
+/// Strain gauges at height z_g: stress tensor components (tension positive).
+struct GaugeProfile {
+  double time = 0.0;              ///< s
+  double height = 0.0;            ///< m, z_g
+  std::vector<double> position;   ///< m, x of each gauge
+  GaugeStresses stress;
+};
+
+/// Energy budget since the loaded equilibrium: work in = Δelastic + Δkinetic + dissipated.
+struct EnergyBudget {
+  double work_in = 0.0;               ///< J, by the pusher's stage and the top load
+  double elastic = 0.0;               ///< J, stored now (springs, foundation, pusher, top, anchors)
+  double initial_elastic = 0.0;       ///< J, stored at the loaded equilibrium
+  double kinetic = 0.0;               ///< J
+  double friction_dissipation = 0.0;  ///< J
+  double viscous_dissipation = 0.0;   ///< J
+  /// J, work_in − (Δelastic + kinetic + dissipation): zero for exact integration
+  double residual() const {
+    return work_in - (elastic - initial_elastic + kinetic + friction_dissipation + viscous_dissipation);
+  }
+  /// residual relative to the largest term of the budget
+  double relativeResidual() const;
+};
+
+}  // namespace friction

@@ -1,0 +1,83 @@
+// The 2D ("1+1D") slider of MODEL.md §2: a square lattice of N_x × N_z nodes in the x–z plane with
+// neighbour springs k, diagonal springs k/2, pair damping η, a one-sided foundation k_f under the
+// bottom row, a top load (uniform or spring mattress) and the pusher K on the trailing edge.
+//
+// Degrees of freedom: u = [u_x of every node, u_z of every node], node (i, j) has index j·N_x + i.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "friction_sim/model.h"
+
+namespace friction {
+
+class Lattice2D : public Model {
+ public:
+  explicit Lattice2D(const Scene& scene);
+
+  int nodesX() const { return nx_; }
+  int nodesZ() const { return nz_; }
+  double spacing() const { return spacing_; }           ///< m, l
+  double springStiffness() const { return k_; }          ///< N/m, k
+  double dampingRate() const { return eta_; }            ///< kg/s, η
+  double foundationStiffness() const { return kf_; }     ///< N/m, k_f
+  int nodeIndex(int i, int j) const { return j * nx_ + i; }
+  int xDof(int node) const { return node; }
+  int zDof(int node) const { return n_ + node; }
+  const std::vector<int>& pushedRows() const { return pushed_rows_; }
+
+  int dofCount() const override { return 2 * n_; }
+  double nodeMass() const override { return mass_; }
+  int interfaceNodeCount() const override { return nx_; }
+  int interfaceDof(int node) const override { return xDof(node); }
+  double interfacePosition(int node) const override { return node * spacing_; }
+  double interfaceNodeArea() const override { return spacing_ * width_; }
+
+  void evaluate(const Vector& u, const Vector& v, double stage_position,
+                ForceEvaluation& out) const override;
+  double elasticEnergy(const Vector& u, double stage_position) const override;
+  double externalWork(const Vector& u_from, const Vector& u_to) const override;
+  SparseMatrix stiffnessMatrix() const override;
+  SparseMatrix dampingMatrix() const override;
+  bool rebalanceLoad(const Vector& u) override;
+  void disconnectPusher() override { pusher_connected_ = false; }
+  void connectPusher(const Vector& u) override;
+  void setNormalLoad(double normal_force) override { normal_force_ = normal_force; }
+  GaugeStresses gaugeStresses(const Vector& u, double height,
+                              const std::vector<double>& positions) const override;
+  void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const override;
+
+  /// Pa, cell-average (virial) stress of cell (i, j) spanning nodes i..i+1, j..j+1, from the spring
+  /// forces: σ = (1/(l²B)) Σ w·T·r̂⊗r, edges weighted ½ (shared with the neighbour cell), diagonals 1.
+  std::array<double, 3> cellStress(const Vector& u, int i, int j) const;
+
+ private:
+  /// One family of bonds: all springs from node (i, j) to (i + di, j + dj).
+  struct BondFamily {
+    int di, dj;
+    double stiffness;    ///< N/m
+    double rest_length;  ///< m
+    double ex, ez;       ///< rest unit vector
+  };
+
+  template <class Visit>
+  void forEachBond(const BondFamily& family, Visit&& visit) const;
+  double topSpringForce(const Vector& u, int i) const;
+
+  int nx_, nz_, n_;
+  double spacing_, width_, mass_, k_, eta_, kf_;
+  bool geometric_;
+  std::vector<BondFamily> families_;
+  double normal_force_;
+  bool mattress_;
+  double mattress_k_, mattress_kx_per_node_;
+  double plate_z_ = 0.0;             ///< m, displacement of the mattress plate
+  std::vector<double> top_anchor_x_;  ///< m, where the mattress holds each top node in x
+  std::vector<int> pushed_rows_;
+  double pusher_k_per_row_;
+  std::vector<double> pusher_offset_;  ///< m, u_x of each pushed node when the pusher was connected
+  bool pusher_connected_ = true;
+};
+
+}  // namespace friction

@@ -1,0 +1,88 @@
+// The elastic slider seen by the integrators: degrees of freedom, the forces on them (everything but
+// friction, which the contact interface adds), energies and linearised matrices. Implemented by the
+// 2D lattice and the 1D chain.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+#include <vector>
+
+#include "friction_sim/scene.h"
+
+namespace friction {
+
+using Vector = Eigen::VectorXd;
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// What one force evaluation produces; friction is not included.
+struct ForceEvaluation {
+  Vector force;              ///< N, per degree of freedom
+  Vector normal_force;       ///< N, per interface node, ≥ 0 (0 = contact lost)
+  double shear_force = 0.0;  ///< N, F_X, the pusher's load-cell reading
+  double normal_load = 0.0;  ///< N, F_Z, the normal load cell (positive when pressing down)
+  double viscous_power = 0.0;  ///< W, dissipated by the pair damping at the given velocities
+};
+
+/// Stress tensor components at the gauge height, at the gauge positions (tension positive).
+struct GaugeStresses {
+  std::vector<double> sigma_xx;  ///< Pa
+  std::vector<double> sigma_zz;  ///< Pa
+  std::vector<double> tau_xz;    ///< Pa
+};
+
+class Model {
+ public:
+  virtual ~Model() = default;
+
+  virtual int dofCount() const = 0;
+  virtual double nodeMass() const = 0;  ///< kg, the same for every node or block
+  virtual int interfaceNodeCount() const = 0;
+  /// Index of the tangential (x) degree of freedom of interface node `node`.
+  virtual int interfaceDof(int node) const = 0;
+  /// m, rest x position of interface node `node`.
+  virtual double interfacePosition(int node) const = 0;
+  /// m², the interface area one node stands for (l·B or a·B), for σ = N/area and τ = f/area.
+  virtual double interfaceNodeArea() const = 0;
+
+  /// Forces at displacements u and velocities v with the stage at `stage_position` (m).
+  virtual void evaluate(const Vector& u, const Vector& v, double stage_position,
+                        ForceEvaluation& out) const = 0;
+  /// J, energy stored in the springs (lattice, foundation, pusher, top load springs).
+  virtual double elasticEnergy(const Vector& u, double stage_position) const = 0;
+  /// J, work done by the constant external forces (the uniform top load) between two states.
+  virtual double externalWork(const Vector& u_from, const Vector& u_to) const = 0;
+
+  /// Stiffness matrix linearised about the rest state, including foundation, pusher and top springs.
+  virtual SparseMatrix stiffnessMatrix() const = 0;
+  /// Damping matrix of the pair damping (force = −C·v).
+  virtual SparseMatrix dampingMatrix() const = 0;
+
+  /// Degrees of freedom held fixed while F_Z is applied (the interface's tangential motion).
+  virtual std::vector<int> blockedDofsDuringLoading() const;
+  /// External forces (N, per dof) applied during the static loading solve in addition to the model's
+  /// own loads, such as a prescribed initial friction profile. Empty = none.
+  virtual Vector initialBodyForce() const { return Vector(); }
+  /// Lets a displacement-controlled load (the spring mattress) re-balance itself during the static
+  /// solve; returns true if it changed.
+  virtual bool rebalanceLoad(const Vector& /*u*/) { return false; }
+
+  /// Pusher connection: while disconnected, the pusher carries no force. `connectPusher` attaches it
+  /// unstretched to the current displacements with the stage at position 0.
+  virtual void disconnectPusher() = 0;
+  virtual void connectPusher(const Vector& u) = 0;
+
+  /// N, sets the normal load F_Z.
+  virtual void setNormalLoad(double normal_force) = 0;
+
+  /// Strain-gauge stresses at height z (m) above the interface at positions x (m).
+  virtual GaugeStresses gaugeStresses(const Vector& u, double height,
+                                      const std::vector<double>& positions) const = 0;
+
+  /// Node positions (rest + displacement) for visualisation: x then z per node.
+  virtual void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const = 0;
+};
+
+std::unique_ptr<Model> buildModel(const Scene& scene);
+
+}  // namespace friction

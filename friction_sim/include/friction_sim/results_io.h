@@ -1,0 +1,44 @@
+// Plain-text results of a run: the slip-event table, the per-node event table, the loading curve and
+// the one-screen summary.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "friction_sim/instruments.h"
+#include "friction_sim/simulation.h"
+#include "friction_sim/slip_events.h"
+
+namespace friction {
+
+struct PrecursorPoint {
+  double shear_ratio = 0.0;    ///< F_X/F_Z at onset
+  double length_ratio = 0.0;   ///< L_p/L
+};
+
+struct RunSummary {
+  std::string scene_name;
+  std::string stop_reason;
+  int events = 0;
+  int precursors = 0;   ///< non-global events before the first global one
+  std::vector<PrecursorPoint> precursor_points;
+  double static_friction_macro = 0.0;  ///< µ_s,macro = F_X/F_Z at the first global event (NaN if none)
+  double simulated_time = 0.0;         ///< s
+  long long steps = 0;
+  double wall_time = 0.0;              ///< s
+  double relative_energy_residual = 0.0;
+  double time_step = 0.0;              ///< s
+  double stability_limit = 0.0;        ///< s
+};
+
+RunSummary summarize(const Simulation& simulation, double wall_time);
+void printSummary(std::ostream& out, const RunSummary& summary);
+
+void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, double slider_length);
+/// One row per (event, interface node): slip, first-unstick time and front speed.
+void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,
+                        const std::vector<double>& node_positions);
+void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& readings);
+
+}  // namespace friction

@@ -1,0 +1,126 @@
+// A scene describes one whole experiment of the rig: the slider model, its material and geometry,
+// the friction law, the loads, the pusher, the stage program, the integrator, the instruments and
+// when to stop. Every field states its unit and meaning; SI units, REP 103 axes (x along the track
+// in the sliding direction, trailing edge at x = 0; z up, interface at z = 0).
+//
+// The defaults are MODEL.md's `pmma_2d` table.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace friction {
+
+enum class ModelKind { Lattice2D, Chain1D };
+enum class SpringForm { Geometric, Linearised };
+enum class TopLoadKind { Uniform, SpringMattress };
+enum class ChainDriving { Side, Top };
+enum class FrictionLawKind { AmontonsCoulomb, SlipWeakening };
+enum class IntegratorKind { VelocityVerlet, RungeKutta4 };
+enum class StageMode { Velocity, Hold, Position };
+
+struct GeometrySpec {
+  double length = 0.140;  ///< m, slider length L along x
+  double height = 0.075;  ///< m, slider height H along z
+  double width = 0.006;   ///< m, slider width B along y (plane-stress thickness)
+};
+
+struct MaterialSpec {
+  double density = 1200.0;        ///< kg/m^3, ρ; slider mass M = ρ·L·H·B
+  double youngs_modulus = 3.0e9;  ///< Pa, E; sets k = 3BE/4 (2D) or k = EHB/a (1D)
+  /// dimensionless c in the pair damping η = sqrt(c·k·m); 0 switches damping off
+  double damping_coefficient = 0.1;
+};
+
+struct LatticeSpec {
+  int nodes_x = 57;  ///< N_x, nodes along x (spacing l = L/(N_x−1) must equal H/(N_z−1))
+  int nodes_z = 31;  ///< N_z, nodes along z
+  /// geometric: central springs along the current bond; linearised: projected on the rest bond
+  SpringForm spring_form = SpringForm::Geometric;
+  double foundation_ratio = 0.5;  ///< k_f/k, one-sided normal spring of each bottom node
+};
+
+struct ChainSpec {
+  int blocks = 57;                         ///< N, number of blocks (1 = a single block on a spring)
+  ChainDriving driving = ChainDriving::Side;  ///< side: pusher on block 0; top: K/N on every block
+  double tilt = 0.0;           ///< θ, dimensionless tilt of the normal load (θ > 0 loads the leading edge)
+  double torque_share = 0.0;   ///< g ∈ [0, 1], share of the moment h·F_X carried by the interface
+  /// N, per-block friction force at t = 0 (empty: no stored shear); length must equal `blocks`
+  std::vector<double> initial_shear;
+};
+
+struct FrictionSpec {
+  FrictionLawKind law = FrictionLawKind::AmontonsCoulomb;
+  double static_coefficient = 0.4;    ///< µ_s
+  double kinetic_coefficient = 0.17;  ///< µ_k (≤ µ_s)
+  double weakening_length = 0.0;      ///< m, ξ_µ of linear slip weakening (0 = Amontons–Coulomb)
+  /// N/m, k_T: a stuck node is held by this spring to its anchor; 0 = rigid stick constraint
+  double interfacial_stiffness = 0.0;
+};
+
+struct LoadSpec {
+  double normal_force = 1920.0;  ///< N, F_Z pressed on the top face (downwards)
+  TopLoadKind top = TopLoadKind::Uniform;  ///< 2D only: how F_Z reaches the top row
+  double mattress_stiffness = 0.0;  ///< N/m per top node, k_top (spring_mattress only; 0 = k)
+  /// N/m, total horizontal stiffness of the mattress plate shared by the top nodes (0 = plate free in x)
+  double mattress_horizontal_stiffness = 0.0;
+};
+
+struct PusherSpec {
+  double stiffness = 4.0e6;  ///< N/m, K, loading-stage stiffness (load cell included)
+  double height = 0.005;     ///< m, h, pushing height above the interface
+  /// m, optional band [band_min, band_max] of pushed rows (2D); equal values = single row at `height`
+  double band_min = -1.0;
+  double band_max = -1.0;
+  bool hasBand() const { return band_min >= 0.0 && band_max >= 0.0; }
+};
+
+/// One segment of the stage program.
+struct StageSegment {
+  StageMode mode = StageMode::Velocity;
+  double speed = 4.0e-4;    ///< m/s, stage speed (velocity mode) or travel speed (position mode)
+  double target = 0.0;      ///< m, stage position to reach (position mode)
+  double duration = std::numeric_limits<double>::infinity();  ///< s, how long the segment lasts
+};
+
+struct StageSpec {
+  std::vector<StageSegment> program{StageSegment{}};  ///< segments run in order; the last one persists
+  double max_speed = 1.0;  ///< m/s, commands faster than this are refused
+};
+
+struct IntegratorSpec {
+  IntegratorKind scheme = IntegratorKind::VelocityVerlet;
+  double time_step = 2.0e-7;  ///< s, dt; must be below the stability limit computed from the scene
+};
+
+struct InstrumentSpec {
+  double loading_curve_rate = 1.0e4;  ///< Hz of simulated time, load-cell samples (F_X, F_Z, ΣN, N_sliding)
+  double gauge_height = 0.002;        ///< m, z_g of the strain gauges above the interface
+  std::vector<double> gauge_positions;  ///< m, gauge x positions; empty = every lattice column
+  int front_fit_nodes = 5;  ///< nodes in the sliding linear fit of first-unstick times for v_c(x)
+};
+
+struct StopSpec {
+  int global_events = 1;  ///< stop after this many global slip events have ended (0 = never)
+  double time = 10.0;     ///< s, simulated time limit
+  double stage_travel = std::numeric_limits<double>::infinity();  ///< m, stop after this stage travel
+};
+
+struct Scene {
+  std::string name = "pmma_2d";
+  ModelKind model = ModelKind::Lattice2D;
+  GeometrySpec geometry;
+  MaterialSpec material;
+  LatticeSpec lattice;
+  ChainSpec chain;
+  FrictionSpec friction;
+  LoadSpec load;
+  PusherSpec pusher;
+  StageSpec stage;
+  IntegratorSpec integrator;
+  InstrumentSpec instruments;
+  StopSpec stop;
+};
+
+}  // namespace friction

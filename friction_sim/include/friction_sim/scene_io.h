@@ -1,0 +1,45 @@
+// Reading scenes from YAML and checking them. A scene is refused before a run starts, with every
+// problem listed at once: unknown keys (typos must not fall back to defaults), wrong types, values out
+// of range and cross-field constraints (µ_k ≤ µ_s, h inside the slider, dt stable, ...).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "friction_sim/scene.h"
+
+namespace friction {
+
+/// Thrown when a scene is refused; `problems()` holds one message per problem, each naming the
+/// field, the value and what is allowed.
+class SceneError : public std::runtime_error {
+ public:
+  explicit SceneError(std::vector<std::string> problems);
+  const std::vector<std::string>& problems() const { return problems_; }
+
+ private:
+  std::vector<std::string> problems_;
+};
+
+/// Parses a scene from YAML text; fields absent from the text keep the defaults of `base`.
+/// Throws SceneError listing every problem (parse and validation).
+Scene parseScene(const std::string& yaml_text, const Scene& base = Scene{});
+
+/// Reads and parses a scene file (see parseScene).
+Scene loadScene(const std::string& path);
+
+/// The scene with fields replaced: each override is a dotted key ("pusher.height") and a YAML value
+/// ("0.01"). The result is parsed and validated like a file. Throws SceneError.
+Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides);
+
+/// Every problem of a scene (empty when valid): ranges, cross-field constraints, dt stability.
+std::vector<std::string> validateScene(const Scene& scene);
+
+/// Throws SceneError if validateScene finds a problem.
+void requireValidScene(const Scene& scene);
+
+/// The scene as YAML text that parseScene reads back to the same scene.
+std::string sceneToYaml(const Scene& scene);
+
+}  // namespace friction

@@ -1,0 +1,94 @@
+// A whole run of the rig: builds the model, the contact interface and the integrator from a scene,
+// applies the loading protocol (F_Z relaxed to static equilibrium with the interface blocked, pusher
+// connected unstretched), then advances in steps of dt while the stage moves, detecting slip events
+// and keeping the energy budget. No ROS here: the offline runner and the ROS node both drive this.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "friction_sim/contact_interface.h"
+#include "friction_sim/instruments.h"
+#include "friction_sim/integrator.h"
+#include "friction_sim/model.h"
+#include "friction_sim/scene.h"
+#include "friction_sim/slip_events.h"
+#include "friction_sim/stage.h"
+
+namespace friction {
+
+class Simulation : public Dynamics {
+ public:
+  /// Throws SceneError if the scene is invalid.
+  explicit Simulation(const Scene& scene);
+
+  /// Advances by one time step.
+  void step();
+  /// Steps until the scene's stop condition holds.
+  void run();
+  /// True once the stop condition holds; `stopReason()` says which.
+  bool finished() const { return !stop_reason_.empty(); }
+  const std::string& stopReason() const { return stop_reason_; }
+
+  double time() const { return time_; }  ///< s, simulated time since the stage started
+  long long steps() const { return steps_; }
+  double timeStep() const { return dt_; }          ///< s
+  double stabilityLimit() const { return stability_limit_; }  ///< s
+
+  LoadCellReading loadCells() const;
+  InterfaceFrame interfaceFrame() const;
+  GaugeProfile gaugeProfile() const;
+  EnergyBudget energy() const;
+  const std::vector<SlipEvent>& events() const { return detector_.events(); }
+  /// True if the last step ended a slip event (events().back()).
+  bool eventEndedLastStep() const { return event_ended_; }
+  int globalEventCount() const { return detector_.globalEventCount(); }
+
+  /// Stage commands from a controller replace the scene's stage program.
+  Stage& stage() { return stage_; }
+  const Stage& stage() const { return stage_; }
+  /// N, changes F_Z during the run; returns the refusal reason or empty.
+  std::string setNormalLoad(double normal_force);
+
+  const Scene& scene() const { return scene_; }
+  const Model& model() const { return *model_; }
+  const ContactInterface& contact() const { return contact_; }
+  const Vector& displacements() const { return u_; }
+  const Vector& velocities() const { return v_; }
+
+  /// FNV-1a hash of the state (time, displacements, velocities, contact states) and the event table.
+  std::uint64_t stateHash() const;
+
+  double acceleration(const Vector& u, const Vector& v, double t, Vector& a) override;
+
+ private:
+  void relaxToLoadedEquilibrium();
+  void reapplyFriction();
+  void checkStop();
+
+  Scene scene_;
+  std::unique_ptr<Model> model_;
+  ContactInterface contact_;
+  std::unique_ptr<Integrator> integrator_;
+  Stage stage_;
+  SlipEventDetector detector_;
+  double dt_;
+  double stability_limit_;
+  double time_ = 0.0;
+  long long steps_ = 0;
+  Vector u_, v_, a_;
+  double power_ = 0.0;  ///< W, viscous power at the current state
+  ForceEvaluation evaluation_;  ///< the last force evaluation (friction excluded)
+  bool event_ended_ = false;
+  std::string stop_reason_;
+  // Energy bookkeeping.
+  double initial_elastic_ = 0.0;
+  double pusher_work_ = 0.0;
+  double external_work_closed_ = 0.0;  ///< J, top-load work before the last change of F_Z
+  Vector external_reference_u_;         ///< displacements at the last change of F_Z
+  double viscous_dissipation_ = 0.0;
+};
+
+}  // namespace friction

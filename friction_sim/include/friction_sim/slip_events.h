@@ -1,0 +1,59 @@
+// Slip events (MODEL.md §6): an event starts when some interface node unsticks while all were stuck
+// and ends when all are stuck again. Detected from the contact interface after every step.
+#pragma once
+
+#include <vector>
+
+#include "friction_sim/contact_interface.h"
+#include "friction_sim/model.h"
+
+namespace friction {
+
+struct SlipEvent {
+  int index = 0;                 ///< 0-based order of the event in the run
+  double onset_time = 0.0;       ///< s
+  double end_time = 0.0;         ///< s
+  double onset_shear_force = 0.0;   ///< N, F_X at onset
+  double onset_normal_force = 0.0;  ///< N, F_Z at onset
+  double end_shear_force = 0.0;     ///< N, F_X at the end
+  double nucleation_position = 0.0;  ///< m, mean x of the nodes that unstuck first
+  double slip_min_x = 0.0;          ///< m, smallest x of a node that slipped
+  double slip_max_x = 0.0;          ///< m, largest x of a node that slipped
+  double rupture_length = 0.0;      ///< m, L_p = slip_max_x − slip_min_x
+  bool global = false;              ///< every interface node slipped
+  std::vector<double> node_slip;    ///< m, per interface node, displacement during the event
+  std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
+  std::vector<double> front_speed;  ///< m/s, v_c per node from the first-unstick times; NaN where undefined
+};
+
+class SlipEventDetector {
+ public:
+  SlipEventDetector(const Model& model, int front_fit_nodes);
+
+  /// Call after every step with the interface's new states. Returns true when an event has just ended
+  /// (then `events().back()` is it).
+  bool update(double time, const ContactInterface& contact, const Vector& u, double shear_force,
+              double normal_force);
+  bool inEvent() const { return in_event_; }
+  const std::vector<SlipEvent>& events() const { return events_; }
+  int globalEventCount() const { return global_count_; }
+
+ private:
+  void finish(double time, const Vector& u, double shear_force);
+
+  std::vector<double> positions_;
+  std::vector<int> dofs_;
+  int fit_nodes_;
+  bool in_event_ = false;
+  SlipEvent current_;
+  std::vector<double> onset_u_;
+  std::vector<SlipEvent> events_;
+  int global_count_ = 0;
+};
+
+/// m/s, front speed per node from first-unstick times t(x) (NaN = not slipped): a linear fit of t against
+/// x over `fit_nodes` consecutive slipped nodes centred on each node; v_c = 1/|dt/dx| (inf if simultaneous).
+std::vector<double> frontSpeeds(const std::vector<double>& positions,
+                                const std::vector<double>& first_unstick_time, int fit_nodes);
+
+}  // namespace friction

@@ -1,0 +1,135 @@
+#include "friction_sim/integrator.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+#include "friction_sim/model.h"
+
+namespace friction {
+
+double VelocityVerlet::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
+                           double dt) {
+  v.noalias() += 0.5 * dt * a;
+  u.noalias() += dt * v;
+  // Midpoint rule: the half-step velocity is the step's mean velocity.
+  power = dynamics.acceleration(u, v, t + dt, a);
+  v.noalias() += 0.5 * dt * a;
+  return power * dt;
+}
+
+double RungeKutta4::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
+                         double dt) {
+  static constexpr double kStageShift[4] = {0.0, 0.5, 0.5, 1.0};
+  static constexpr double kWeight[4] = {1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0};
+  k_u_[0] = v;
+  k_v_[0] = a;
+  double dissipated = kWeight[0] * dt * power;
+  for (int stage = 1; stage < 4; ++stage) {
+    const double h = kStageShift[stage] * dt;
+    u_stage_ = u + h * k_u_[stage - 1];
+    v_stage_ = v + h * k_v_[stage - 1];
+    k_u_[stage] = v_stage_;
+    dissipated += kWeight[stage] * dt * dynamics.acceleration(u_stage_, v_stage_, t + h, k_v_[stage]);
+  }
+  for (int stage = 0; stage < 4; ++stage) {
+    u.noalias() += kWeight[stage] * dt * k_u_[stage];
+    v.noalias() += kWeight[stage] * dt * k_v_[stage];
+  }
+  power = dynamics.acceleration(u, v, t + dt, a);
+  return dissipated;
+}
+
+std::unique_ptr<Integrator> buildIntegrator(IntegratorKind kind) {
+  if (kind == IntegratorKind::RungeKutta4) return std::make_unique<RungeKutta4>();
+  return std::make_unique<VelocityVerlet>();
+}
+
+namespace {
+
+class DampedOscillator : public Dynamics {
+ public:
+  DampedOscillator(double omega, double damping_rate) : omega_(omega), damping_rate_(damping_rate) {}
+  double acceleration(const Vector& u, const Vector& v, double, Vector& a) override {
+    a.resize(1);
+    a[0] = -omega_ * omega_ * u[0] - damping_rate_ * v[0];
+    return 0.0;
+  }
+
+ private:
+  double omega_, damping_rate_;
+};
+
+double spectralRadius(IntegratorKind kind, double omega, double damping_rate, double dt) {
+  DampedOscillator oscillator(omega, damping_rate);
+  auto integrator = buildIntegrator(kind);
+  Eigen::Matrix3d map;
+  for (int column = 0; column < 3; ++column) {
+    Vector u = Vector::Constant(1, column == 0 ? 1.0 : 0.0);
+    Vector v = Vector::Constant(1, column == 1 ? 1.0 : 0.0);
+    Vector a = Vector::Constant(1, column == 2 ? 1.0 : 0.0);
+    if (kind == IntegratorKind::RungeKutta4) oscillator.acceleration(u, v, 0.0, a);
+    double power = 0.0;
+    integrator->step(oscillator, u, v, a, power, 0.0, dt);
+    map.col(column) << u[0], v[0], a[0];
+  }
+  return map.eigenvalues().cwiseAbs().maxCoeff();
+}
+
+double largestEigenvalue(const SparseMatrix& matrix) {
+  const int n = static_cast<int>(matrix.rows());
+  Vector x(n);
+  // Start close to the grid-scale (alternating) modes, with every other mode present too.
+  for (int i = 0; i < n; ++i) x[i] = (i % 2 ? -1.0 : 1.0) * (1.0 + 0.3 * std::sin(1.7 * i + 0.3));
+  x.normalize();
+  double estimate = 0.0;
+  for (int iteration = 0; iteration < 2000; ++iteration) {
+    Vector y = matrix * x;
+    const double rayleigh = x.dot(y);
+    const double norm = y.norm();
+    if (norm == 0.0) return 0.0;
+    x = y / norm;
+    if (iteration > 20 && std::abs(rayleigh - estimate) <= 1e-10 * std::abs(rayleigh)) return rayleigh;
+    estimate = rayleigh;
+  }
+  return estimate;
+}
+
+}  // namespace
+
+double stabilityLimit(IntegratorKind kind, double omega_max, double damping_rate) {
+  if (omega_max <= 0.0 && damping_rate <= 0.0) return std::numeric_limits<double>::infinity();
+  const double scale = 1.0 / std::max(omega_max, damping_rate);
+  auto stable = [&](double dt) { return spectralRadius(kind, omega_max, damping_rate, dt) <= 1.0 + 1e-9; };
+  double low = 0.0, high = scale;
+  while (stable(high)) {
+    low = high;
+    high *= 1.5;
+  }
+  for (int iteration = 0; iteration < 60; ++iteration) {
+    const double mid = 0.5 * (low + high);
+    (stable(mid) ? low : high) = mid;
+  }
+  return low;
+}
+
+ModeBounds modeBounds(const Model& model, double interfacial_stiffness) {
+  SparseMatrix stiffness = model.stiffnessMatrix();
+  for (int node = 0; node < model.interfaceNodeCount(); ++node) {
+    const int dof = model.interfaceDof(node);
+    stiffness.coeffRef(dof, dof) += interfacial_stiffness;
+  }
+  // Power iteration approaches from below; 1 % covers what is left after it stops.
+  constexpr double kMargin = 1.01;
+  ModeBounds bounds;
+  bounds.omega_max = std::sqrt(kMargin * largestEigenvalue(stiffness) / model.nodeMass());
+  bounds.damping_rate = kMargin * largestEigenvalue(model.dampingMatrix()) / model.nodeMass();
+  return bounds;
+}
+
+double sceneStabilityLimit(const Scene& scene) {
+  const auto model = buildModel(scene);
+  const ModeBounds bounds = modeBounds(*model, scene.friction.interfacial_stiffness);
+  return stabilityLimit(scene.integrator.scheme, bounds.omega_max, bounds.damping_rate);
+}
+
+}  // namespace friction

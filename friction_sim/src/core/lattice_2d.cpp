@@ -1,0 +1,335 @@
+#include "friction_sim/lattice_2d.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace friction {
+
+namespace {
+std::vector<int> pushedRowsOf(const PusherSpec& pusher, double spacing, int nz) {
+  std::vector<int> rows;
+  if (pusher.hasBand()) {
+    for (int j = 0; j < nz; ++j) {
+      const double z = j * spacing;
+      if (z >= pusher.band_min - 1e-9 * spacing && z <= pusher.band_max + 1e-9 * spacing) rows.push_back(j);
+    }
+  } else {
+    rows.push_back(std::clamp(static_cast<int>(std::lround(pusher.height / spacing)), 0, nz - 1));
+  }
+  return rows;
+}
+}  // namespace
+
+Lattice2D::Lattice2D(const Scene& scene)
+    : nx_(scene.lattice.nodes_x),
+      nz_(scene.lattice.nodes_z),
+      n_(nx_ * nz_),
+      spacing_(scene.geometry.length / (nx_ - 1)),
+      width_(scene.geometry.width),
+      mass_(scene.material.density * scene.geometry.length * scene.geometry.height *
+            scene.geometry.width / n_),
+      k_(0.75 * scene.geometry.width * scene.material.youngs_modulus),
+      eta_(std::sqrt(scene.material.damping_coefficient * k_ * mass_)),
+      kf_(scene.lattice.foundation_ratio * k_),
+      geometric_(scene.lattice.spring_form == SpringForm::Geometric),
+      normal_force_(scene.load.normal_force),
+      mattress_(scene.load.top == TopLoadKind::SpringMattress),
+      mattress_k_(scene.load.mattress_stiffness > 0 ? scene.load.mattress_stiffness : k_),
+      mattress_kx_per_node_(scene.load.mattress_horizontal_stiffness / nx_),
+      top_anchor_x_(nx_, 0.0),
+      pushed_rows_(pushedRowsOf(scene.pusher, spacing_, nz_)),
+      pusher_k_per_row_(scene.pusher.stiffness / pushed_rows_.size()),
+      pusher_offset_(pushed_rows_.size(), 0.0) {
+  const double diagonal = spacing_ * std::sqrt(2.0);
+  const double c = 1.0 / std::sqrt(2.0);
+  families_ = {{1, 0, k_, spacing_, 1.0, 0.0},
+               {0, 1, k_, spacing_, 0.0, 1.0},
+               {1, 1, 0.5 * k_, diagonal, c, c},
+               {-1, 1, 0.5 * k_, diagonal, -c, c}};
+  // Start the mattress plate where it carries F_Z with the slider undeformed.
+  plate_z_ = -normal_force_ / (nx_ * mattress_k_);
+}
+
+template <class Visit>
+void Lattice2D::forEachBond(const BondFamily& family, Visit&& visit) const {
+  const int i_begin = std::max(0, -family.di);
+  const int i_end = nx_ - std::max(0, family.di);
+  const int offset = family.dj * nx_ + family.di;
+  for (int j = 0; j + family.dj < nz_; ++j) {
+    const int row = j * nx_;
+    for (int i = i_begin; i < i_end; ++i) visit(row + i, row + i + offset);
+  }
+}
+
+double Lattice2D::topSpringForce(const Vector& u, int i) const {
+  return mattress_k_ * (plate_z_ - u[zDof(nodeIndex(i, nz_ - 1))]);
+}
+
+void Lattice2D::evaluate(const Vector& u, const Vector& v, double stage_position,
+                         ForceEvaluation& out) const {
+  out.force.setZero(2 * n_);
+  out.normal_force.resize(nx_);
+  double* fx = out.force.data();
+  double* fz = out.force.data() + n_;
+  const double* ux = u.data();
+  const double* uz = u.data() + n_;
+  const double* vx = v.data();
+  const double* vz = v.data() + n_;
+  double viscous_power = 0.0;
+  for (const BondFamily& family : families_) {
+    const double rest_x = family.ex * family.rest_length;
+    const double rest_z = family.ez * family.rest_length;
+    const double kb = family.stiffness;
+    forEachBond(family, [&](int a, int b) {
+      const double dux = ux[b] - ux[a];
+      const double duz = uz[b] - uz[a];
+      double bond_fx, bond_fz;
+      if (geometric_) {
+        const double rx = rest_x + dux;
+        const double rz = rest_z + duz;
+        const double length = std::sqrt(rx * rx + rz * rz);
+        const double tension_per_length = kb * (length - family.rest_length) / length;
+        bond_fx = tension_per_length * rx;
+        bond_fz = tension_per_length * rz;
+      } else {
+        const double stretch = family.ex * dux + family.ez * duz;
+        bond_fx = kb * stretch * family.ex;
+        bond_fz = kb * stretch * family.ez;
+      }
+      const double dvx = vx[b] - vx[a];
+      const double dvz = vz[b] - vz[a];
+      bond_fx += eta_ * dvx;
+      bond_fz += eta_ * dvz;
+      viscous_power += eta_ * (dvx * dvx + dvz * dvz);
+      fx[a] += bond_fx;
+      fz[a] += bond_fz;
+      fx[b] -= bond_fx;
+      fz[b] -= bond_fz;
+    });
+  }
+  double normal_sum_top = 0.0;
+  for (int i = 0; i < nx_; ++i) {
+    const double normal = kf_ * std::max(0.0, -uz[i]);
+    out.normal_force[i] = normal;
+    fz[i] += normal;
+    const int top = nodeIndex(i, nz_ - 1);
+    if (mattress_) {
+      const double spring = topSpringForce(u, i);
+      fz[top] += spring;
+      fx[top] += mattress_kx_per_node_ * (top_anchor_x_[i] - ux[top]);
+      normal_sum_top -= spring;
+    } else {
+      fz[top] -= normal_force_ / nx_;
+    }
+  }
+  out.normal_load = mattress_ ? normal_sum_top : normal_force_;
+  double shear = 0.0;
+  if (pusher_connected_) {
+    for (std::size_t r = 0; r < pushed_rows_.size(); ++r) {
+      const int node = nodeIndex(0, pushed_rows_[r]);
+      const double force = pusher_k_per_row_ * (stage_position + pusher_offset_[r] - ux[node]);
+      fx[node] += force;
+      shear += force;
+    }
+  }
+  out.shear_force = shear;
+  out.viscous_power = viscous_power;
+}
+
+double Lattice2D::elasticEnergy(const Vector& u, double stage_position) const {
+  const double* ux = u.data();
+  const double* uz = u.data() + n_;
+  double energy = 0.0;
+  for (const BondFamily& family : families_) {
+    forEachBond(family, [&](int a, int b) {
+      const double dux = ux[b] - ux[a];
+      const double duz = uz[b] - uz[a];
+      double stretch;
+      if (geometric_) {
+        stretch = std::hypot(family.ex * family.rest_length + dux, family.ez * family.rest_length + duz) -
+                  family.rest_length;
+      } else {
+        stretch = family.ex * dux + family.ez * duz;
+      }
+      energy += 0.5 * family.stiffness * stretch * stretch;
+    });
+  }
+  for (int i = 0; i < nx_; ++i) {
+    const double penetration = std::max(0.0, -uz[i]);
+    energy += 0.5 * kf_ * penetration * penetration;
+    if (mattress_) {
+      const int top = nodeIndex(i, nz_ - 1);
+      const double dz = plate_z_ - uz[top];
+      const double dx = top_anchor_x_[i] - ux[top];
+      energy += 0.5 * mattress_k_ * dz * dz + 0.5 * mattress_kx_per_node_ * dx * dx;
+    }
+  }
+  if (pusher_connected_) {
+    for (std::size_t r = 0; r < pushed_rows_.size(); ++r) {
+      const double stretch = stage_position + pusher_offset_[r] - ux[nodeIndex(0, pushed_rows_[r])];
+      energy += 0.5 * pusher_k_per_row_ * stretch * stretch;
+    }
+  }
+  return energy;
+}
+
+double Lattice2D::externalWork(const Vector& u_from, const Vector& u_to) const {
+  if (mattress_) return 0.0;
+  double sum = 0.0;
+  for (int i = 0; i < nx_; ++i) {
+    const int dof = zDof(nodeIndex(i, nz_ - 1));
+    sum += u_to[dof] - u_from[dof];
+  }
+  return -normal_force_ / nx_ * sum;
+}
+
+SparseMatrix Lattice2D::stiffnessMatrix() const {
+  std::vector<Eigen::Triplet<double>> entries;
+  auto add = [&](int row, int col, double value) { entries.emplace_back(row, col, value); };
+  for (const BondFamily& family : families_) {
+    const double e[2] = {family.ex, family.ez};
+    forEachBond(family, [&](int a, int b) {
+      const int dofs_a[2] = {xDof(a), zDof(a)};
+      const int dofs_b[2] = {xDof(b), zDof(b)};
+      for (int p = 0; p < 2; ++p) {
+        for (int q = 0; q < 2; ++q) {
+          const double kpq = family.stiffness * e[p] * e[q];
+          add(dofs_a[p], dofs_a[q], kpq);
+          add(dofs_b[p], dofs_b[q], kpq);
+          add(dofs_a[p], dofs_b[q], -kpq);
+          add(dofs_b[p], dofs_a[q], -kpq);
+        }
+      }
+    });
+  }
+  for (int i = 0; i < nx_; ++i) {
+    add(zDof(i), zDof(i), kf_);
+    if (mattress_) {
+      const int top = nodeIndex(i, nz_ - 1);
+      add(zDof(top), zDof(top), mattress_k_);
+      add(xDof(top), xDof(top), mattress_kx_per_node_);
+    }
+  }
+  if (pusher_connected_) {
+    for (int row : pushed_rows_) add(xDof(nodeIndex(0, row)), xDof(nodeIndex(0, row)), pusher_k_per_row_);
+  }
+  SparseMatrix matrix(2 * n_, 2 * n_);
+  matrix.setFromTriplets(entries.begin(), entries.end());
+  return matrix;
+}
+
+SparseMatrix Lattice2D::dampingMatrix() const {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (const BondFamily& family : families_) {
+    forEachBond(family, [&](int a, int b) {
+      for (int dof_shift : {0, n_}) {
+        entries.emplace_back(a + dof_shift, a + dof_shift, eta_);
+        entries.emplace_back(b + dof_shift, b + dof_shift, eta_);
+        entries.emplace_back(a + dof_shift, b + dof_shift, -eta_);
+        entries.emplace_back(b + dof_shift, a + dof_shift, -eta_);
+      }
+    });
+  }
+  SparseMatrix matrix(2 * n_, 2 * n_);
+  matrix.setFromTriplets(entries.begin(), entries.end());
+  return matrix;
+}
+
+bool Lattice2D::rebalanceLoad(const Vector& u) {
+  if (!mattress_) return false;
+  double carried = 0.0;
+  for (int i = 0; i < nx_; ++i) carried -= topSpringForce(u, i);
+  const double correction = (carried - normal_force_) / (nx_ * mattress_k_);
+  plate_z_ += correction;
+  for (int i = 0; i < nx_; ++i) top_anchor_x_[i] = u[xDof(nodeIndex(i, nz_ - 1))];
+  return std::abs(correction) > 1e-15 * spacing_;
+}
+
+void Lattice2D::connectPusher(const Vector& u) {
+  pusher_connected_ = true;
+  for (std::size_t r = 0; r < pushed_rows_.size(); ++r) {
+    pusher_offset_[r] = u[xDof(nodeIndex(0, pushed_rows_[r]))];
+  }
+}
+
+std::array<double, 3> Lattice2D::cellStress(const Vector& u, int i, int j) const {
+  struct CellBond {
+    int ia, ja, ib, jb;
+    double weight;
+    const BondFamily* family;
+  };
+  const CellBond bonds[6] = {{i, j, i + 1, j, 0.5, &families_[0]},
+                             {i, j + 1, i + 1, j + 1, 0.5, &families_[0]},
+                             {i, j, i, j + 1, 0.5, &families_[1]},
+                             {i + 1, j, i + 1, j + 1, 0.5, &families_[1]},
+                             {i, j, i + 1, j + 1, 1.0, &families_[2]},
+                             {i + 1, j, i, j + 1, 1.0, &families_[3]}};
+  std::array<double, 3> stress{0.0, 0.0, 0.0};  // σ_xx, σ_zz, τ_xz
+  for (const CellBond& bond : bonds) {
+    const int a = nodeIndex(bond.ia, bond.ja);
+    const int b = nodeIndex(bond.ib, bond.jb);
+    const BondFamily& family = *bond.family;
+    const double rx = family.ex * family.rest_length + u[xDof(b)] - u[xDof(a)];
+    const double rz = family.ez * family.rest_length + u[zDof(b)] - u[zDof(a)];
+    double tension_per_length;
+    if (geometric_) {
+      const double length = std::hypot(rx, rz);
+      tension_per_length = family.stiffness * (length - family.rest_length) / length;
+    } else {
+      const double stretch = family.ex * (u[xDof(b)] - u[xDof(a)]) + family.ez * (u[zDof(b)] - u[zDof(a)]);
+      tension_per_length = family.stiffness * stretch / family.rest_length;
+    }
+    stress[0] += bond.weight * tension_per_length * rx * rx;
+    stress[1] += bond.weight * tension_per_length * rz * rz;
+    stress[2] += bond.weight * tension_per_length * rx * rz;
+  }
+  const double volume = spacing_ * spacing_ * width_;
+  for (double& component : stress) component /= volume;
+  return stress;
+}
+
+GaugeStresses Lattice2D::gaugeStresses(const Vector& u, double height,
+                                       const std::vector<double>& positions) const {
+  GaugeStresses out;
+  // Cell centres sit at ((i + ½)l, (j + ½)l); interpolate bilinearly between them, clamped at the edges.
+  auto bracket = [](double coordinate, int cells, int& low, double& fraction) {
+    const double s = std::clamp(coordinate - 0.5, 0.0, static_cast<double>(cells - 1));
+    low = std::min(static_cast<int>(s), std::max(cells - 2, 0));
+    fraction = cells > 1 ? s - low : 0.0;
+  };
+  int j0;
+  double fz;
+  bracket(height / spacing_, nz_ - 1, j0, fz);
+  const int j1 = std::min(j0 + 1, nz_ - 2);
+  for (double x : positions) {
+    int i0;
+    double fx;
+    bracket(x / spacing_, nx_ - 1, i0, fx);
+    const int i1 = std::min(i0 + 1, nx_ - 2);
+    const auto s00 = cellStress(u, i0, j0), s10 = cellStress(u, i1, j0);
+    const auto s01 = cellStress(u, i0, j1), s11 = cellStress(u, i1, j1);
+    double value[3];
+    for (int c = 0; c < 3; ++c) {
+      value[c] = (1 - fx) * (1 - fz) * s00[c] + fx * (1 - fz) * s10[c] + (1 - fx) * fz * s01[c] +
+                 fx * fz * s11[c];
+    }
+    out.sigma_xx.push_back(value[0]);
+    out.sigma_zz.push_back(value[1]);
+    out.tau_xz.push_back(value[2]);
+  }
+  return out;
+}
+
+void Lattice2D::nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const {
+  x.resize(n_);
+  z.resize(n_);
+  for (int j = 0; j < nz_; ++j) {
+    for (int i = 0; i < nx_; ++i) {
+      const int node = nodeIndex(i, j);
+      x[node] = i * spacing_ + u[xDof(node)];
+      z[node] = j * spacing_ + u[zDof(node)];
+    }
+  }
+}
+
+}  // namespace friction

@@ -1,0 +1,99 @@
+#include "friction_sim/results_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+
+namespace friction {
+
+RunSummary summarize(const Simulation& simulation, double wall_time) {
+  RunSummary summary;
+  const Scene& scene = simulation.scene();
+  summary.scene_name = scene.name;
+  summary.stop_reason = simulation.stopReason();
+  summary.events = static_cast<int>(simulation.events().size());
+  summary.static_friction_macro = std::numeric_limits<double>::quiet_NaN();
+  for (const SlipEvent& event : simulation.events()) {
+    if (event.global) {
+      summary.static_friction_macro = event.onset_shear_force / event.onset_normal_force;
+      break;
+    }
+    ++summary.precursors;
+    summary.precursor_points.push_back(
+        {event.onset_shear_force / event.onset_normal_force, event.rupture_length / scene.geometry.length});
+  }
+  summary.simulated_time = simulation.time();
+  summary.steps = simulation.steps();
+  summary.wall_time = wall_time;
+  summary.relative_energy_residual = simulation.energy().relativeResidual();
+  summary.time_step = simulation.timeStep();
+  summary.stability_limit = simulation.stabilityLimit();
+  return summary;
+}
+
+void printSummary(std::ostream& out, const RunSummary& s) {
+  out << "scene " << s.scene_name << ": " << s.stop_reason << "\n"
+      << "  simulated " << s.simulated_time << " s in " << s.steps << " steps of " << s.time_step
+      << " s (stability limit " << s.stability_limit << " s)\n"
+      << "  wall time " << std::setprecision(3) << s.wall_time << " s, "
+      << std::setprecision(4) << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
+      << "  slip events: " << s.events << ", precursors before the first global event: " << s.precursors
+      << "\n";
+  if (!s.precursor_points.empty()) {
+    out << "  precursors (F_X/F_Z, L_p/L):";
+    for (const PrecursorPoint& point : s.precursor_points) {
+      out << " (" << std::setprecision(4) << point.shear_ratio << ", " << point.length_ratio << ")";
+    }
+    out << "\n";
+  }
+  out << "  mu_s,macro = F_X/F_Z at the first global event: " << s.static_friction_macro << "\n"
+      << "  energy-balance residual (relative): " << std::setprecision(3) << s.relative_energy_residual << "\n";
+}
+
+namespace {
+double maxFinite(const std::vector<double>& values) {
+  double best = std::numeric_limits<double>::quiet_NaN();
+  for (double value : values) {
+    if (std::isfinite(value) && !(value <= best)) best = value;
+  }
+  return best;
+}
+}  // namespace
+
+void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, double slider_length) {
+  out << "index,onset_time_s,end_time_s,onset_shear_force_N,onset_normal_force_N,shear_ratio,"
+         "end_shear_force_N,nucleation_x_m,slip_min_x_m,slip_max_x_m,rupture_length_m,length_ratio,global,"
+         "max_front_speed_m_s\n";
+  out << std::setprecision(12);
+  for (const SlipEvent& e : events) {
+    out << e.index << ',' << e.onset_time << ',' << e.end_time << ',' << e.onset_shear_force << ','
+        << e.onset_normal_force << ',' << e.onset_shear_force / e.onset_normal_force << ',' << e.end_shear_force
+        << ',' << e.nucleation_position << ',' << e.slip_min_x << ',' << e.slip_max_x << ',' << e.rupture_length
+        << ',' << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << maxFinite(e.front_speed)
+        << '\n';
+  }
+}
+
+void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,
+                        const std::vector<double>& node_positions) {
+  out << "event,node,x_m,slip_m,first_unstick_time_s,front_speed_m_s\n";
+  out << std::setprecision(12);
+  for (const SlipEvent& e : events) {
+    for (std::size_t node = 0; node < node_positions.size(); ++node) {
+      out << e.index << ',' << node << ',' << node_positions[node] << ',' << e.node_slip[node] << ','
+          << e.first_unstick_time[node] << ',' << e.front_speed[node] << '\n';
+    }
+  }
+}
+
+void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& readings) {
+  out << "time_s,stage_position_m,shear_force_N,normal_force_N,interface_normal_sum_N,sliding_nodes\n";
+  out << std::setprecision(12);
+  for (const LoadCellReading& r : readings) {
+    out << r.time << ',' << r.stage_position << ',' << r.shear_force << ',' << r.normal_force << ','
+        << r.interface_normal_sum << ',' << r.sliding_nodes << '\n';
+  }
+}
+
+}  // namespace friction

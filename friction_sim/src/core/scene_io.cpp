@@ -1,0 +1,385 @@
+#include "friction_sim/scene_io.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+#include <utility>
+
+namespace friction {
+
+namespace {
+
+template <class E>
+using EnumTable = std::vector<std::pair<E, const char*>>;
+
+const EnumTable<ModelKind> kModelNames{{ModelKind::Lattice2D, "lattice_2d"},
+                                       {ModelKind::Chain1D, "chain_1d"}};
+const EnumTable<SpringForm> kSpringFormNames{{SpringForm::Geometric, "geometric"},
+                                             {SpringForm::Linearised, "linearised"}};
+const EnumTable<TopLoadKind> kTopLoadNames{{TopLoadKind::Uniform, "uniform"},
+                                           {TopLoadKind::SpringMattress, "spring_mattress"}};
+const EnumTable<ChainDriving> kDrivingNames{{ChainDriving::Side, "side"},
+                                            {ChainDriving::Top, "top"}};
+const EnumTable<FrictionLawKind> kLawNames{{FrictionLawKind::AmontonsCoulomb, "amontons_coulomb"},
+                                           {FrictionLawKind::SlipWeakening, "slip_weakening"}};
+const EnumTable<IntegratorKind> kSchemeNames{{IntegratorKind::VelocityVerlet, "velocity_verlet"},
+                                             {IntegratorKind::RungeKutta4, "rk4"}};
+const EnumTable<StageMode> kStageModeNames{
+    {StageMode::Velocity, "velocity"}, {StageMode::Hold, "hold"}, {StageMode::Position, "position"}};
+
+const EnumTable<ModelKind>& enumTable(ModelKind) { return kModelNames; }
+const EnumTable<SpringForm>& enumTable(SpringForm) { return kSpringFormNames; }
+const EnumTable<TopLoadKind>& enumTable(TopLoadKind) { return kTopLoadNames; }
+const EnumTable<ChainDriving>& enumTable(ChainDriving) { return kDrivingNames; }
+const EnumTable<FrictionLawKind>& enumTable(FrictionLawKind) { return kLawNames; }
+const EnumTable<IntegratorKind>& enumTable(IntegratorKind) { return kSchemeNames; }
+const EnumTable<StageMode>& enumTable(StageMode) { return kStageModeNames; }
+
+template <class E>
+std::string allowedNames(const EnumTable<E>& table) {
+  std::string out;
+  for (const auto& entry : table) out += (out.empty() ? "" : " | ") + std::string(entry.second);
+  return out;
+}
+
+std::string formatNumber(double value) {
+  std::ostringstream text;
+  text.precision(10);
+  text << value;
+  return text.str();
+}
+
+// The one description of the scene's YAML layout, walked by both the reader and the writer so that
+// the two cannot drift apart.
+template <class Visitor>
+void visitScene(Scene& s, Visitor& v) {
+  v.field("name", s.name);
+  v.field("model", s.model);
+  v.section("geometry", [&] {
+    v.field("length", s.geometry.length);
+    v.field("height", s.geometry.height);
+    v.field("width", s.geometry.width);
+  });
+  v.section("material", [&] {
+    v.field("density", s.material.density);
+    v.field("youngs_modulus", s.material.youngs_modulus);
+    v.field("damping_coefficient", s.material.damping_coefficient);
+  });
+  v.section("lattice", [&] {
+    v.field("nodes_x", s.lattice.nodes_x);
+    v.field("nodes_z", s.lattice.nodes_z);
+    v.field("spring_form", s.lattice.spring_form);
+    v.field("foundation_ratio", s.lattice.foundation_ratio);
+  });
+  v.section("chain", [&] {
+    v.field("blocks", s.chain.blocks);
+    v.field("driving", s.chain.driving);
+    v.field("tilt", s.chain.tilt);
+    v.field("torque_share", s.chain.torque_share);
+    v.field("initial_shear", s.chain.initial_shear);
+  });
+  v.section("friction", [&] {
+    v.field("law", s.friction.law);
+    v.field("static_coefficient", s.friction.static_coefficient);
+    v.field("kinetic_coefficient", s.friction.kinetic_coefficient);
+    v.field("weakening_length", s.friction.weakening_length);
+    v.field("interfacial_stiffness", s.friction.interfacial_stiffness);
+  });
+  v.section("load", [&] {
+    v.field("normal_force", s.load.normal_force);
+    v.field("top", s.load.top);
+    v.field("mattress_stiffness", s.load.mattress_stiffness);
+    v.field("mattress_horizontal_stiffness", s.load.mattress_horizontal_stiffness);
+  });
+  v.section("pusher", [&] {
+    v.field("stiffness", s.pusher.stiffness);
+    v.field("height", s.pusher.height);
+    v.field("band_min", s.pusher.band_min);
+    v.field("band_max", s.pusher.band_max);
+  });
+  v.section("stage", [&] {
+    v.field("max_speed", s.stage.max_speed);
+    v.list("program", s.stage.program, [&](StageSegment& segment) {
+      v.field("mode", segment.mode);
+      v.field("speed", segment.speed);
+      v.field("target", segment.target);
+      v.field("duration", segment.duration);
+    });
+  });
+  v.section("integrator", [&] {
+    v.field("scheme", s.integrator.scheme);
+    v.field("time_step", s.integrator.time_step);
+  });
+  v.section("instruments", [&] {
+    v.field("loading_curve_rate", s.instruments.loading_curve_rate);
+    v.field("gauge_height", s.instruments.gauge_height);
+    v.field("gauge_positions", s.instruments.gauge_positions);
+    v.field("front_fit_nodes", s.instruments.front_fit_nodes);
+  });
+  v.section("stop", [&] {
+    v.field("global_events", s.stop.global_events);
+    v.field("time", s.stop.time);
+    v.field("stage_travel", s.stop.stage_travel);
+  });
+}
+
+class YamlReader {
+ public:
+  YamlReader(const YAML::Node& root, std::vector<std::string>& problems)
+      : node_(root), problems_(problems) {}
+
+  template <class T>
+  void field(const char* key, T& value) {
+    used_.insert(key);
+    const YAML::Node child = node_[key];
+    if (!child) return;
+    read(child, path(key), value);
+  }
+
+  void section(const char* key, const std::function<void()>& body) {
+    used_.insert(key);
+    const YAML::Node child = node_[key];
+    if (!child) return;
+    if (!child.IsMap()) {
+      problems_.push_back(path(key) + ": expected a mapping of fields");
+      return;
+    }
+    enter(child, path(key), body);
+  }
+
+  template <class T, class Body>
+  void list(const char* key, std::vector<T>& items, Body&& body) {
+    used_.insert(key);
+    const YAML::Node child = node_[key];
+    if (!child) return;
+    if (!child.IsSequence() || child.size() == 0) {
+      problems_.push_back(path(key) + ": expected a non-empty list");
+      return;
+    }
+    items.assign(child.size(), T{});
+    for (std::size_t i = 0; i < child.size(); ++i) {
+      const std::string item_path = path(key) + "[" + std::to_string(i) + "]";
+      if (!child[i].IsMap()) {
+        problems_.push_back(item_path + ": expected a mapping of fields");
+        continue;
+      }
+      enter(child[i], item_path, [&] { body(items[i]); });
+    }
+  }
+
+  /// Reports every key of the current mapping that no field claimed.
+  void rejectUnknownKeys() {
+    for (const auto& entry : node_) {
+      const std::string key = entry.first.as<std::string>();
+      if (!used_.count(key)) {
+        std::string allowed;
+        for (const auto& name : used_) allowed += (allowed.empty() ? "" : ", ") + name;
+        problems_.push_back(path(key) + ": unknown key; allowed keys here: " + allowed);
+      }
+    }
+  }
+
+ private:
+  void enter(const YAML::Node& child, const std::string& child_path, const std::function<void()>& body) {
+    YAML::Node saved_node = node_;
+    std::string saved_prefix = prefix_;
+    std::set<std::string> saved_used;
+    saved_used.swap(used_);
+    node_.reset(child);
+    prefix_ = child_path + ".";
+    body();
+    rejectUnknownKeys();
+    node_.reset(saved_node);
+    prefix_ = saved_prefix;
+    used_.swap(saved_used);
+  }
+
+  std::string path(const std::string& key) const { return prefix_ + key; }
+
+  void read(const YAML::Node& node, const std::string& where, double& value) {
+    try {
+      value = node.as<double>();
+    } catch (const YAML::Exception&) {
+      problems_.push_back(where + ": value '" + YAML::Dump(node) + "' is not a number");
+    }
+  }
+  void read(const YAML::Node& node, const std::string& where, int& value) {
+    try {
+      value = node.as<int>();
+    } catch (const YAML::Exception&) {
+      problems_.push_back(where + ": value '" + YAML::Dump(node) + "' is not an integer");
+    }
+  }
+  void read(const YAML::Node& node, const std::string& where, std::string& value) {
+    if (!node.IsScalar()) {
+      problems_.push_back(where + ": expected a string");
+      return;
+    }
+    value = node.as<std::string>();
+  }
+  void read(const YAML::Node& node, const std::string& where, std::vector<double>& value) {
+    if (!node.IsSequence()) {
+      problems_.push_back(where + ": expected a list of numbers");
+      return;
+    }
+    value.clear();
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      double item = 0.0;
+      read(node[i], where + "[" + std::to_string(i) + "]", item);
+      value.push_back(item);
+    }
+  }
+  template <class E, class = std::enable_if_t<std::is_enum<E>::value>>
+  void read(const YAML::Node& node, const std::string& where, E& value) {
+    const std::string text = node.IsScalar() ? node.as<std::string>() : YAML::Dump(node);
+    for (const auto& entry : enumTable(E{})) {
+      if (text == entry.second) {
+        value = entry.first;
+        return;
+      }
+    }
+    problems_.push_back(where + ": value '" + text + "' is not allowed; allowed: " +
+                        allowedNames(enumTable(E{})));
+  }
+
+  YAML::Node node_;
+  std::string prefix_;
+  std::set<std::string> used_;
+  std::vector<std::string>& problems_;
+};
+
+class YamlWriter {
+ public:
+  explicit YamlWriter(YAML::Emitter& out) : out_(out) {}
+
+  template <class T>
+  void field(const char* key, T& value) {
+    out_ << YAML::Key << key << YAML::Value;
+    write(value);
+  }
+  void section(const char* key, const std::function<void()>& body) {
+    out_ << YAML::Key << key << YAML::Value << YAML::BeginMap;
+    body();
+    out_ << YAML::EndMap;
+  }
+  template <class T, class Body>
+  void list(const char* key, std::vector<T>& items, Body&& body) {
+    out_ << YAML::Key << key << YAML::Value << YAML::BeginSeq;
+    for (auto& item : items) {
+      out_ << YAML::Flow << YAML::BeginMap;
+      body(item);
+      out_ << YAML::EndMap;
+    }
+    out_ << YAML::EndSeq;
+  }
+
+ private:
+  void write(double value) {
+    if (std::isinf(value)) {
+      out_ << (value > 0 ? ".inf" : "-.inf");
+    } else {
+      out_ << formatNumber(value);
+    }
+  }
+  void write(int value) { out_ << value; }
+  void write(const std::string& value) { out_ << value; }
+  void write(const std::vector<double>& values) {
+    out_ << YAML::Flow << YAML::BeginSeq;
+    for (double value : values) write(value);
+    out_ << YAML::EndSeq;
+  }
+  template <class E, class = std::enable_if_t<std::is_enum<E>::value>>
+  void write(E value) {
+    for (const auto& entry : enumTable(E{})) {
+      if (entry.first == value) out_ << entry.second;
+    }
+  }
+
+  YAML::Emitter& out_;
+};
+
+}  // namespace
+
+SceneError::SceneError(std::vector<std::string> problems)
+    : std::runtime_error([&] {
+        std::string text = "scene refused (" + std::to_string(problems.size()) + " problem" +
+                           (problems.size() == 1 ? "" : "s") + "):";
+        for (const auto& problem : problems) text += "\n  - " + problem;
+        return text;
+      }()),
+      problems_(std::move(problems)) {}
+
+Scene parseScene(const std::string& yaml_text, const Scene& base) {
+  Scene scene = base;
+  std::vector<std::string> problems;
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& error) {
+    throw SceneError({std::string("YAML syntax error: ") + error.what()});
+  }
+  if (!root.IsMap()) throw SceneError({"scene: expected a mapping of sections at the top level"});
+  YamlReader reader(root, problems);
+  visitScene(scene, reader);
+  reader.rejectUnknownKeys();
+  // Validate even after parse problems so that one refusal lists everything wrong with the file.
+  for (auto& problem : validateScene(scene)) problems.push_back(std::move(problem));
+  if (!problems.empty()) throw SceneError(problems);
+  return scene;
+}
+
+Scene loadScene(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw SceneError({"scene file '" + path + "' cannot be read"});
+  std::stringstream text;
+  text << file.rdbuf();
+  return parseScene(text.str());
+}
+
+Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides) {
+  YAML::Node root(YAML::NodeType::Map);
+  std::vector<std::string> problems;
+  for (const auto& [key, value] : overrides) {
+    std::vector<std::string> parts;
+    std::stringstream stream(key);
+    for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
+    if (parts.empty() || std::find(parts.begin(), parts.end(), "") != parts.end()) {
+      problems.push_back("override '" + key + "': expected a dotted key such as pusher.height");
+      continue;
+    }
+    YAML::Node node = root;
+    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+      if (!node[parts[i]]) node[parts[i]] = YAML::Node(YAML::NodeType::Map);
+      node.reset(node[parts[i]]);
+    }
+    try {
+      node[parts.back()] = YAML::Load(value);
+    } catch (const YAML::Exception& error) {
+      problems.push_back("override '" + key + "': value '" + value + "' is not YAML: " + error.what());
+    }
+  }
+  if (!problems.empty()) throw SceneError(problems);
+  return parseScene(YAML::Dump(root), base);
+}
+
+std::string sceneToYaml(const Scene& scene) {
+  Scene copy = scene;
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  YamlWriter writer(out);
+  visitScene(copy, writer);
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+void requireValidScene(const Scene& scene) {
+  auto problems = validateScene(scene);
+  if (!problems.empty()) throw SceneError(problems);
+}
+
+}  // namespace friction

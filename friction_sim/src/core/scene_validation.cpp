@@ -1,0 +1,160 @@
+// Every check a scene must pass before a run starts, in one place.
+#include <cmath>
+#include <sstream>
+
+#include "friction_sim/chain_1d.h"
+#include "friction_sim/integrator.h"
+#include "friction_sim/scene_io.h"
+
+namespace friction {
+
+namespace {
+
+class Checker {
+ public:
+  /// Records "field: value V is not allowed; allowed: ..." unless `ok`.
+  void require(bool ok, const std::string& field, double value, const std::string& allowed) {
+    if (ok) return;
+    std::ostringstream text;
+    text.precision(10);
+    text << field << ": value " << value << " is not allowed; allowed: " << allowed;
+    problems.push_back(text.str());
+  }
+  void positive(const std::string& field, double value) {
+    require(std::isfinite(value) && value > 0.0, field, value, "a finite number > 0");
+  }
+  void nonNegative(const std::string& field, double value) {
+    require(std::isfinite(value) && value >= 0.0, field, value, "a finite number >= 0");
+  }
+  void within(const std::string& field, double value, double low, double high, const std::string& what) {
+    std::ostringstream allowed;
+    allowed << "[" << low << ", " << high << "] (" << what << ")";
+    require(value >= low && value <= high, field, value, allowed.str());
+  }
+  std::vector<std::string> problems;
+};
+
+}  // namespace
+
+std::vector<std::string> validateScene(const Scene& s) {
+  Checker check;
+  const bool lattice = s.model == ModelKind::Lattice2D;
+  check.positive("geometry.length", s.geometry.length);
+  check.positive("geometry.height", s.geometry.height);
+  check.positive("geometry.width", s.geometry.width);
+  check.positive("material.density", s.material.density);
+  check.positive("material.youngs_modulus", s.material.youngs_modulus);
+  check.nonNegative("material.damping_coefficient", s.material.damping_coefficient);
+
+  if (lattice) {
+    check.require(s.lattice.nodes_x >= 2, "lattice.nodes_x", s.lattice.nodes_x, "an integer >= 2");
+    check.require(s.lattice.nodes_z >= 2, "lattice.nodes_z", s.lattice.nodes_z, "an integer >= 2");
+    if (s.lattice.nodes_x >= 2 && s.lattice.nodes_z >= 2 && s.geometry.length > 0 && s.geometry.height > 0) {
+      const double spacing_x = s.geometry.length / (s.lattice.nodes_x - 1);
+      const double spacing_z = s.geometry.height / (s.lattice.nodes_z - 1);
+      std::ostringstream allowed;
+      allowed << "a square lattice: geometry.height/(nodes_z-1) = " << spacing_z
+              << " m must equal geometry.length/(nodes_x-1) = " << spacing_x << " m";
+      check.require(std::abs(spacing_x - spacing_z) <= 1e-6 * spacing_x, "lattice.nodes_z", s.lattice.nodes_z,
+                    allowed.str());
+    }
+    check.positive("lattice.foundation_ratio", s.lattice.foundation_ratio);
+    check.within("instruments.gauge_height", s.instruments.gauge_height, 0.0, s.geometry.height,
+                 "inside the slider, 0..geometry.height");
+  } else {
+    check.require(s.chain.blocks >= 1, "chain.blocks", s.chain.blocks, "an integer >= 1");
+    check.require(std::isfinite(s.chain.tilt), "chain.tilt", s.chain.tilt, "a finite number");
+    check.within("chain.torque_share", s.chain.torque_share, 0.0, 1.0, "share of the moment h*F_X");
+    check.require(s.load.top == TopLoadKind::Uniform, "load.top", static_cast<double>(s.load.top),
+                  "uniform (the chain has no top row)");
+    if (!s.chain.initial_shear.empty()) {
+      check.require(static_cast<int>(s.chain.initial_shear.size()) == s.chain.blocks,
+                    "chain.initial_shear (length)", s.chain.initial_shear.size(),
+                    "one force per block (chain.blocks) or an empty list");
+      for (std::size_t i = 0; i < s.chain.initial_shear.size(); ++i) {
+        check.require(std::isfinite(s.chain.initial_shear[i]), "chain.initial_shear[" + std::to_string(i) + "]",
+                      s.chain.initial_shear[i], "a finite force in N");
+      }
+    }
+  }
+
+  const double mu_s = s.friction.static_coefficient, mu_k = s.friction.kinetic_coefficient;
+  check.nonNegative("friction.static_coefficient", mu_s);
+  check.within("friction.kinetic_coefficient", mu_k, 0.0, std::max(mu_s, 0.0),
+               "0 <= mu_k <= mu_s = friction.static_coefficient");
+  check.nonNegative("friction.weakening_length", s.friction.weakening_length);
+  check.nonNegative("friction.interfacial_stiffness", s.friction.interfacial_stiffness);
+
+  check.positive("load.normal_force", s.load.normal_force);
+  check.nonNegative("load.mattress_stiffness", s.load.mattress_stiffness);
+  check.nonNegative("load.mattress_horizontal_stiffness", s.load.mattress_horizontal_stiffness);
+
+  check.positive("pusher.stiffness", s.pusher.stiffness);
+  check.within("pusher.height", s.pusher.height, 0.0, s.geometry.height, "inside the slider, 0..geometry.height");
+  if (s.pusher.band_min >= 0.0 || s.pusher.band_max >= 0.0) {
+    check.require(lattice, "pusher.band_min", s.pusher.band_min, "a band only on the 2D lattice");
+    check.within("pusher.band_min", s.pusher.band_min, 0.0, s.pusher.band_max, "0..pusher.band_max");
+    check.within("pusher.band_max", s.pusher.band_max, std::max(s.pusher.band_min, 0.0), s.geometry.height,
+                 "pusher.band_min..geometry.height");
+    if (lattice && s.lattice.nodes_z >= 2) {
+      const double spacing = s.geometry.height / (s.lattice.nodes_z - 1);
+      const bool holds_a_row = std::floor(s.pusher.band_max / spacing + 1e-9) >= std::ceil(s.pusher.band_min / spacing - 1e-9);
+      check.require(holds_a_row, "pusher.band_max", s.pusher.band_max,
+                    "a band [band_min, band_max] that contains at least one lattice row");
+    }
+  }
+
+  check.positive("stage.max_speed", s.stage.max_speed);
+  for (std::size_t i = 0; i < s.stage.program.size(); ++i) {
+    const StageSegment& segment = s.stage.program[i];
+    const std::string where = "stage.program[" + std::to_string(i) + "]";
+    check.require(std::isfinite(segment.speed) && std::abs(segment.speed) <= s.stage.max_speed, where + ".speed",
+                  segment.speed, "|speed| <= stage.max_speed");
+    check.require(segment.duration > 0.0, where + ".duration", segment.duration, "a duration > 0 s (.inf allowed)");
+    if (segment.mode == StageMode::Position) {
+      check.require(segment.speed > 0.0, where + ".speed", segment.speed, "a travel speed > 0 in position mode");
+      check.require(std::isfinite(segment.target), where + ".target", segment.target, "a finite position");
+    }
+  }
+
+  check.positive("instruments.loading_curve_rate", s.instruments.loading_curve_rate);
+  for (std::size_t i = 0; i < s.instruments.gauge_positions.size(); ++i) {
+    check.within("instruments.gauge_positions[" + std::to_string(i) + "]", s.instruments.gauge_positions[i], 0.0,
+                 s.geometry.length, "along the slider, 0..geometry.length");
+  }
+  check.require(s.instruments.front_fit_nodes >= 2, "instruments.front_fit_nodes", s.instruments.front_fit_nodes,
+                "an integer >= 2");
+  check.require(s.stop.global_events >= 0, "stop.global_events", s.stop.global_events, "an integer >= 0");
+  check.positive("stop.time", s.stop.time);
+  check.require(s.stop.stage_travel > 0.0, "stop.stage_travel", s.stop.stage_travel, "a travel > 0 m (.inf allowed)");
+  check.positive("integrator.time_step", s.integrator.time_step);
+
+  if (!check.problems.empty()) return check.problems;
+
+  // Cross-field checks that need a consistent model.
+  if (!lattice) {
+    const Chain1D chain(s);
+    // F_X stays between 0 and the interface's total static friction µ_s·F_Z.
+    for (double shear : {0.0, mu_s * s.load.normal_force}) {
+      const std::vector<double> w = chain.normalForces(shear);
+      for (std::size_t i = 0; i < w.size(); ++i) {
+        if (w[i] > 0.0) continue;
+        std::ostringstream text;
+        text << "chain.tilt/chain.torque_share: the normal force of block " << i << " would be " << w[i]
+             << " N at F_X = " << shear << " N; allowed: every block's normal force w_i > 0 for F_X in [0, "
+             << mu_s * s.load.normal_force << "] N (reduce tilt, torque_share or pusher.height)";
+        check.problems.push_back(text.str());
+        break;
+      }
+    }
+  }
+  const double limit = sceneStabilityLimit(s);
+  std::ostringstream allowed;
+  allowed.precision(4);
+  allowed << "dt < " << limit << " s, the stability limit of this scene for "
+          << (s.integrator.scheme == IntegratorKind::RungeKutta4 ? "rk4" : "velocity_verlet");
+  check.require(s.integrator.time_step < limit, "integrator.time_step", s.integrator.time_step, allowed.str());
+  return check.problems;
+}
+
+}  // namespace friction

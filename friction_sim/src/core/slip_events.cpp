@@ -1,0 +1,102 @@
+#include "friction_sim/slip_events.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace friction {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}
+
+SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes) : fit_nodes_(front_fit_nodes) {
+  for (int node = 0; node < model.interfaceNodeCount(); ++node) {
+    positions_.push_back(model.interfacePosition(node));
+    dofs_.push_back(model.interfaceDof(node));
+  }
+  onset_u_.resize(positions_.size());
+}
+
+bool SlipEventDetector::update(double time, const ContactInterface& contact, const Vector& u,
+                               double shear_force, double normal_force) {
+  const auto& unstuck = contact.unstuckLastStep();
+  if (!in_event_ && !unstuck.empty()) {
+    in_event_ = true;
+    const std::size_t n = positions_.size();
+    current_ = SlipEvent{};
+    current_.index = static_cast<int>(events_.size());
+    current_.onset_time = time;
+    current_.onset_shear_force = shear_force;
+    current_.onset_normal_force = normal_force;
+    current_.first_unstick_time.assign(n, kNaN);
+    double sum = 0.0;
+    for (int node : unstuck) sum += positions_[node];
+    current_.nucleation_position = sum / unstuck.size();
+    for (std::size_t node = 0; node < n; ++node) onset_u_[node] = u[dofs_[node]];
+  }
+  if (!in_event_) return false;
+  for (int node : unstuck) {
+    if (std::isnan(current_.first_unstick_time[node])) current_.first_unstick_time[node] = time;
+  }
+  if (contact.slidingCount() > 0) return false;
+  finish(time, u, shear_force);
+  return true;
+}
+
+void SlipEventDetector::finish(double time, const Vector& u, double shear_force) {
+  in_event_ = false;
+  SlipEvent& event = current_;
+  event.end_time = time;
+  event.end_shear_force = shear_force;
+  const std::size_t n = positions_.size();
+  event.node_slip.resize(n);
+  double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
+  std::size_t slipped = 0;
+  for (std::size_t node = 0; node < n; ++node) {
+    event.node_slip[node] = u[dofs_[node]] - onset_u_[node];
+    if (!std::isnan(event.first_unstick_time[node])) {
+      ++slipped;
+      x_min = std::min(x_min, positions_[node]);
+      x_max = std::max(x_max, positions_[node]);
+    }
+  }
+  event.slip_min_x = x_min;
+  event.slip_max_x = x_max;
+  event.rupture_length = x_max - x_min;
+  event.global = slipped == n;
+  event.front_speed = frontSpeeds(positions_, event.first_unstick_time, fit_nodes_);
+  if (event.global) ++global_count_;
+  events_.push_back(std::move(event));
+}
+
+std::vector<double> frontSpeeds(const std::vector<double>& positions,
+                                const std::vector<double>& first_unstick_time, int fit_nodes) {
+  const int n = static_cast<int>(positions.size());
+  std::vector<double> speed(n, kNaN);
+  const int half = std::max(fit_nodes, 2) / 2;
+  for (int centre = 0; centre < n; ++centre) {
+    if (std::isnan(first_unstick_time[centre])) continue;
+    // Fit over the slipped nodes of the window around the centre, not across unslipped gaps.
+    int low = centre, high = centre;
+    while (low > 0 && centre - low < half && !std::isnan(first_unstick_time[low - 1])) --low;
+    while (high + 1 < n && high - centre < half && !std::isnan(first_unstick_time[high + 1])) ++high;
+    if (high == low) continue;
+    double mean_x = 0.0, mean_t = 0.0;
+    const int count = high - low + 1;
+    for (int i = low; i <= high; ++i) {
+      mean_x += positions[i] / count;
+      mean_t += first_unstick_time[i] / count;
+    }
+    double sxx = 0.0, sxt = 0.0;
+    for (int i = low; i <= high; ++i) {
+      sxx += (positions[i] - mean_x) * (positions[i] - mean_x);
+      sxt += (positions[i] - mean_x) * (first_unstick_time[i] - mean_t);
+    }
+    const double slowness = std::abs(sxt / sxx);
+    speed[centre] = slowness > 0.0 ? 1.0 / slowness : std::numeric_limits<double>::infinity();
+  }
+  return speed;
+}
+
+}  // namespace friction

@@ -1,0 +1,69 @@
+#include "friction_sim/stage.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace friction {
+
+Stage::Stage(const StageSpec& spec) : spec_(spec) { enterSegment(0); }
+
+void Stage::enterSegment(std::size_t index) {
+  segment_ = index;
+  segment_elapsed_ = 0.0;
+  const StageSegment& segment = spec_.program[index];
+  current_ = StageCommand{segment.mode, segment.speed, segment.target};
+}
+
+double Stage::velocity() const {
+  switch (current_.mode) {
+    case StageMode::Velocity:
+      return current_.speed;
+    case StageMode::Position:
+      if (position_ == current_.target) return 0.0;
+      return position_ < current_.target ? current_.speed : -current_.speed;
+    case StageMode::Hold:
+      break;
+  }
+  return 0.0;
+}
+
+double Stage::positionAfter(double lead) const {
+  const double next = position_ + velocity() * lead;
+  if (current_.mode != StageMode::Position) return next;
+  const bool passed = (next - current_.target) * (position_ - current_.target) < 0.0;
+  return passed ? current_.target : next;
+}
+
+std::string Stage::checkCommand(const StageCommand& command) const {
+  std::ostringstream reason;
+  if (!std::isfinite(command.speed) || !std::isfinite(command.target)) {
+    reason << "speed " << command.speed << " m/s and target " << command.target << " m must be finite";
+  } else if (std::abs(command.speed) > spec_.max_speed) {
+    reason << "speed " << command.speed << " m/s exceeds the stage's max_speed " << spec_.max_speed << " m/s";
+  } else if (command.mode == StageMode::Position && command.speed <= 0.0) {
+    reason << "a position command needs a travel speed > 0 m/s, got " << command.speed;
+  }
+  return reason.str();
+}
+
+std::string Stage::command(const StageCommand& command) {
+  std::string reason = checkCommand(command);
+  if (reason.empty()) {
+    current_ = command;
+    following_program_ = false;
+  }
+  return reason;
+}
+
+void Stage::advance(double dt) {
+  const double next = positionAfter(dt);
+  travel_ += std::abs(next - position_);
+  position_ = next;
+  if (!following_program_) return;
+  segment_elapsed_ += dt;
+  if (segment_elapsed_ >= spec_.program[segment_].duration && segment_ + 1 < spec_.program.size()) {
+    enterSegment(segment_ + 1);
+  }
+}
+
+}  // namespace friction
