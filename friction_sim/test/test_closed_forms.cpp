@@ -1,1 +1,183 @@
+// MODEL.md §7: the single block's stick–slip cycle, the chain's normal modes and the conservation of
+// energy, each against its closed form.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "friction_sim/chain_1d.h"
+#include "friction_sim/integrator.h"
+#include "friction_sim/simulation.h"
+#include "test_helpers.h"
+
+namespace friction {
+namespace {
+
+using testing::singleBlockScene;
+
+struct SingleBlockCase {
+  IntegratorKind scheme;
+  double direction;  // +1 pushes along +x, −1 pulls back
+};
+
+class SingleBlockStickSlip : public ::testing::TestWithParam<SingleBlockCase> {};
+
+TEST_P(SingleBlockStickSlip, MatchesTheClosedFormCycle) {
+  const auto [scheme, direction] = GetParam();
+  const double speed = 0.8;  // m/s: ωΔ/V ≈ 1, so stick and slip take comparable numbers of steps
+  Simulation simulation(singleBlockScene(scheme, direction * speed, 1e-9));
+  const Scene& scene = simulation.scene();
+  simulation.run();
+
+  const double mass = simulation.model().nodeMass();
+  const double stiffness = scene.pusher.stiffness;
+  const double normal = scene.load.normal_force;
+  const double mu_s = scene.friction.static_coefficient, mu_k = scene.friction.kinetic_coefficient;
+  const double omega = std::sqrt(stiffness / mass);
+  const double delta = (mu_s - mu_k) * normal / stiffness;
+  const double slip_time = 2.0 / omega * (M_PI - std::atan(omega * delta / speed));
+  const double stick_time = 2.0 * delta / speed;
+
+  const auto& events = simulation.events();
+  ASSERT_EQ(events.size(), 3u);
+  for (std::size_t e = 0; e < events.size(); ++e) {
+    const SlipEvent& event = events[e];
+    SCOPED_TRACE("event " + std::to_string(e));
+    EXPECT_TRUE(event.global);
+    EXPECT_NEAR(direction * event.onset_shear_force, mu_s * normal, 1e-6 * mu_s * normal);
+    EXPECT_NEAR(event.end_time - event.onset_time, slip_time, 1e-6 * slip_time);
+    EXPECT_NEAR(direction * (event.onset_shear_force - event.end_shear_force), 2.0 * (mu_s - mu_k) * normal,
+                1e-6 * 2.0 * (mu_s - mu_k) * normal);
+    EXPECT_NEAR(direction * event.end_shear_force, (2.0 * mu_k - mu_s) * normal,
+                1e-6 * std::abs((2.0 * mu_k - mu_s) * normal));
+    const double slip_per_cycle = speed * slip_time + 2.0 * delta;
+    EXPECT_NEAR(direction * event.node_slip[0], slip_per_cycle, 1e-6 * slip_per_cycle);
+    if (e + 1 < events.size()) {
+      EXPECT_NEAR(events[e + 1].onset_time - event.end_time, stick_time, 1e-6 * stick_time);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(BothIntegratorsBothDirections, SingleBlockStickSlip,
+                         ::testing::Values(SingleBlockCase{IntegratorKind::VelocityVerlet, 1.0},
+                                           SingleBlockCase{IntegratorKind::VelocityVerlet, -1.0},
+                                           SingleBlockCase{IntegratorKind::RungeKutta4, 1.0},
+                                           SingleBlockCase{IntegratorKind::RungeKutta4, -1.0}));
+
+/// Frictionless, unpushed elastic body integrated directly: u'' = F(u, u')/m.
+class FreeBody : public Dynamics {
+ public:
+  explicit FreeBody(Model& model) : model_(model) { model_.disconnectPusher(); }
+  double acceleration(const Vector& u, const Vector& v, double, Vector& a) override {
+    model_.evaluate(u, v, 0.0, evaluation_);
+    a = evaluation_.force / model_.nodeMass();
+    return evaluation_.viscous_power;
+  }
+  double energy(const Vector& u, const Vector& v) const {
+    return model_.elasticEnergy(u, 0.0) + 0.5 * model_.nodeMass() * v.squaredNorm();
+  }
+
+ private:
+  Model& model_;
+  ForceEvaluation evaluation_;
+};
+
+Scene chainScene(int blocks, double damping_coefficient) {
+  Scene scene;
+  scene.model = ModelKind::Chain1D;
+  scene.chain.blocks = blocks;
+  scene.material.damping_coefficient = damping_coefficient;
+  return scene;
+}
+
+/// Frequency and damping ratio of mode j of a free chain, measured from a simulated free decay.
+struct MeasuredMode {
+  double omega_damped = 0.0;
+  double log_decrement = 0.0;
+};
+
+MeasuredMode measureMode(const Scene& scene, int mode) {
+  Chain1D chain(scene);
+  FreeBody body(chain);
+  const int n = scene.chain.blocks;
+  const double qa = M_PI * mode / n;
+  Vector shape(n);
+  for (int i = 0; i < n; ++i) shape[i] = std::cos(qa * (i + 0.5));
+  Vector u = 1e-7 * shape, v = Vector::Zero(n), a;
+  double power = body.acceleration(u, v, 0.0, a);
+  const double omega = 2.0 * std::sqrt(chain.springStiffness() / chain.nodeMass()) * std::sin(qa / 2);
+  const double dt = 2.0 * M_PI / omega / 4000.0;
+  VelocityVerlet verlet;
+  // Successive maxima of the modal amplitude give the period and the logarithmic decrement.
+  std::vector<double> peak_times, peak_values;
+  double previous = shape.dot(u), before_previous = previous;
+  for (int step = 1; step <= 4000 * 6; ++step) {
+    verlet.step(body, u, v, a, power, 0.0, dt);
+    const double amplitude = shape.dot(u);
+    if (step >= 2 && previous > before_previous && previous >= amplitude) {
+      // Parabola through the three samples around the maximum.
+      const double curvature = before_previous - 2 * previous + amplitude;
+      const double offset = 0.5 * (before_previous - amplitude) / curvature;
+      peak_times.push_back((step - 1 + offset) * dt);
+      peak_values.push_back(previous - 0.25 * (before_previous - amplitude) * offset);
+    }
+    before_previous = previous;
+    previous = amplitude;
+  }
+  MeasuredMode measured;
+  const std::size_t cycles = peak_times.size() - 1;
+  measured.omega_damped = 2.0 * M_PI * cycles / (peak_times.back() - peak_times.front());
+  measured.log_decrement = std::log(peak_values.front() / peak_values.back()) / cycles;
+  return measured;
+}
+
+TEST(ChainNormalModes, FrequenciesAndDampingRatiosMatchTheClosedForm) {
+  for (int mode : {1, 3, 7}) {
+    SCOPED_TRACE("mode " + std::to_string(mode));
+    const Scene scene = chainScene(16, 0.01);
+    const Chain1D chain(scene);
+    const double qa = M_PI * mode / scene.chain.blocks;
+    const double omega = 2.0 * std::sqrt(chain.springStiffness() / chain.nodeMass()) * std::sin(qa / 2);
+    const double zeta = chain.dampingRate() / std::sqrt(chain.springStiffness() * chain.nodeMass()) * std::sin(qa / 2);
+    const MeasuredMode measured = measureMode(scene, mode);
+    EXPECT_NEAR(measured.omega_damped, omega * std::sqrt(1 - zeta * zeta), 1e-4 * omega);
+    const double expected_decrement = 2.0 * M_PI * zeta / std::sqrt(1 - zeta * zeta);
+    EXPECT_NEAR(measured.log_decrement, expected_decrement, 1e-3 * expected_decrement);
+  }
+}
+
+TEST(ChainNormalModes, LongWaveSpeedIsTheBarSpeed) {
+  const Scene scene = chainScene(57, 0.1);
+  const Chain1D chain(scene);
+  const int n = scene.chain.blocks;
+  // a·sqrt(k/m) with m = M/N and a = L/(N−1): the bar speed sqrt(E/ρ) up to the factor sqrt(N/(N−1)).
+  const double speed = chain.spacing() * std::sqrt(chain.springStiffness() / chain.nodeMass());
+  EXPECT_NEAR(speed, std::sqrt(scene.material.youngs_modulus / scene.material.density * n / (n - 1)), 1e-9 * speed);
+}
+
+TEST(Conservation, VerletEnergyErrorStaysBoundedOverAMillionSteps) {
+  const Scene scene = chainScene(8, 0.0);
+  Chain1D chain(scene);
+  FreeBody body(chain);
+  Vector u(8), v = Vector::Zero(8), a;
+  for (int i = 0; i < 8; ++i) u[i] = 1e-7 * std::sin(1.3 * i * i + 0.4);
+  double power = body.acceleration(u, v, 0.0, a);
+  const double energy0 = body.energy(u, v);
+  const ModeBounds bounds = modeBounds(chain, 0.0);
+  const double dt = 0.05 * stabilityLimit(IntegratorKind::VelocityVerlet, bounds.omega_max, 0.0);
+  VelocityVerlet verlet;
+  double early_error = 0.0, late_error = 0.0;
+  const int steps = 1000000;
+  for (int step = 1; step <= steps; ++step) {
+    verlet.step(body, u, v, a, power, 0.0, dt);
+    const double error = std::abs(body.energy(u, v) - energy0) / energy0;
+    double& worst = step <= steps / 10 ? early_error : late_error;
+    worst = std::max(worst, error);
+  }
+  // Symplectic: the error oscillates at O((ω dt)²/8) ≈ 1e-3 here and does not grow.
+  EXPECT_LT(late_error, 3e-3);
+  EXPECT_LT(late_error, 1.5 * early_error);
+}
+
+}  // namespace
+}  // namespace friction

@@ -1,1 +1,182 @@
+// MODEL.md §4, branch by branch: stick, stick→slip, sliding in both directions, re-stick at the zero
+// crossing, weakening over ξ_µ, loss and return of contact, the elastic anchor k_T.
 #include <gtest/gtest.h>
+
+#include "friction_sim/chain_1d.h"
+#include "friction_sim/contact_interface.h"
+
+namespace friction {
+namespace {
+
+constexpr double kMuS = 0.4, kMuK = 0.17;
+
+/// One interface node (a single block) whose forces the test sets by hand.
+class OneNode : public ::testing::Test {
+ protected:
+  OneNode() : block_(blockScene()), contact_(std::make_unique<AmontonsCoulomb>(kMuS, kMuK), block_, 0.0) {
+    u_ = Vector::Zero(1);
+    v_ = Vector::Zero(1);
+    contact_.reset(u_);
+  }
+  static Scene blockScene() {
+    Scene scene;
+    scene.model = ModelKind::Chain1D;
+    scene.chain.blocks = 1;
+    return scene;
+  }
+  /// Friction for a tangential force `other` (N) and normal force `normal` (N); returns the net force.
+  double net(double other, double normal) {
+    raw_.force = Vector::Constant(1, other);
+    raw_.normal_force = Vector::Constant(1, normal);
+    Vector force = raw_.force;
+    contact_.applyFriction(raw_, u_, force);
+    return force[0];
+  }
+  bool update(double other, double normal) {
+    raw_.force = Vector::Constant(1, other);
+    raw_.normal_force = Vector::Constant(1, normal);
+    return contact_.updateStates(raw_, u_, v_, 0.0, 1.0);
+  }
+
+  Chain1D block_;
+  ContactInterface contact_;
+  ForceEvaluation raw_;
+  Vector u_, v_;
+};
+
+TEST_F(OneNode, StuckNodeCarriesWhateverHoldsItUpToStaticFriction) {
+  EXPECT_DOUBLE_EQ(net(3.9, 10.0), 0.0);
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -3.9);
+  EXPECT_FALSE(update(3.9, 10.0));
+  EXPECT_FALSE(update(-4.0, 10.0));  // exactly µ_s·N still holds
+  EXPECT_EQ(contact_.state(0), ContactState::Stuck);
+}
+
+TEST_F(OneNode, UnsticksBeyondStaticFrictionAndSlidesAgainstKineticFriction) {
+  EXPECT_TRUE(update(4.1, 10.0));
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  EXPECT_DOUBLE_EQ(net(4.1, 10.0), 4.1 - kMuK * 10.0);
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -kMuK * 10.0);
+}
+
+TEST_F(OneNode, SlidesBackwardsWithFrictionReversed) {
+  EXPECT_TRUE(update(-4.1, 10.0));
+  EXPECT_DOUBLE_EQ(net(-4.1, 10.0), -4.1 + kMuK * 10.0);
+  // The friction force follows the current normal force while sliding.
+  EXPECT_DOUBLE_EQ(net(-1.0, 20.0), -1.0 + kMuK * 20.0);
+}
+
+TEST_F(OneNode, ReSticksAtTheInterpolatedZeroCrossingOfTheVelocity) {
+  update(4.1, 10.0);
+  net(4.1, 10.0);
+  // A step that is not the one right after unsticking: the velocity goes from +2 to −1 m/s.
+  const double dt = 1e-3;
+  contact_.beginStep(u_, v_);
+  contact_.finishStep(u_, v_, dt);  // clears "just unstuck"
+  v_[0] = 2.0;
+  u_[0] = 0.5;
+  contact_.beginStep(u_, v_);
+  u_[0] = 0.5 + 0.5 * dt;
+  v_[0] = -1.0;
+  EXPECT_TRUE(contact_.finishStep(u_, v_, dt));
+  EXPECT_EQ(contact_.state(0), ContactState::Stuck);
+  EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), 2.0 / 3.0);
+  // Velocity linear over the step: it stops after 2/3 dt, having moved ½·2·(2/3)dt.
+  EXPECT_DOUBLE_EQ(u_[0], 0.5 + 2.0 / 3.0 * dt);
+  EXPECT_DOUBLE_EQ(v_[0], 0.0);
+}
+
+TEST_F(OneNode, CannotReStickInTheStepRightAfterUnsticking) {
+  update(4.1, 10.0);
+  contact_.beginStep(u_, v_);
+  v_[0] = -1e-3;
+  EXPECT_FALSE(contact_.finishStep(u_, v_, 1e-3));
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+}
+
+TEST_F(OneNode, LosesContactAtZeroNormalForceAndRecovers) {
+  EXPECT_TRUE(update(1.0, 0.0));
+  EXPECT_EQ(contact_.state(0), ContactState::Detached);
+  EXPECT_DOUBLE_EQ(net(1.0, 0.0), 1.0);  // no friction without contact
+  v_[0] = -0.2;
+  EXPECT_TRUE(update(1.0, 10.0));
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), 0.0);
+  EXPECT_DOUBLE_EQ(net(1.0, 10.0), 1.0 + kMuK * 10.0);  // sliding towards −x: friction along +x
+  update(1.0, 0.0);
+  v_[0] = 0.0;
+  EXPECT_TRUE(update(1.0, 10.0));
+  EXPECT_EQ(contact_.state(0), ContactState::Stuck);  // returns at rest: sticks
+}
+
+TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
+  update(3.0, 10.0);  // load ratio 0.75
+  raw_.force = Vector::Constant(1, 5.0);  // load ratio 1.25: crossed µ_s·N halfway through the step
+  raw_.normal_force = Vector::Constant(1, 10.0);
+  const double dt = 1e-3, mass = 2.0;
+  ASSERT_TRUE(contact_.updateStates(raw_, u_, v_, dt, mass));
+  EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), 0.5);
+  const double acceleration = (5.0 - kMuK * 10.0) / mass;
+  EXPECT_DOUBLE_EQ(v_[0], acceleration * 0.5 * dt);
+  EXPECT_DOUBLE_EQ(u_[0], 0.5 * acceleration * 0.25 * dt * dt);
+}
+
+TEST(LinearSlipWeakening, WeakensLinearlyOverTheWeakeningLength) {
+  LinearSlipWeakening law(kMuS, kMuK, 1e-5);
+  law.resize(2);
+  law.onUnstick(0);
+  EXPECT_DOUBLE_EQ(law.staticCoefficient(0), kMuS);
+  EXPECT_DOUBLE_EQ(law.slidingCoefficient(0), kMuS);
+  law.onSlip(0, 2.5e-6);
+  law.onSlip(0, -2.5e-6);  // slip counts in either direction
+  EXPECT_DOUBLE_EQ(law.slidingCoefficient(0), kMuS - 0.5 * (kMuS - kMuK));
+  law.onSlip(0, 1e-5);
+  EXPECT_DOUBLE_EQ(law.slidingCoefficient(0), kMuK);
+  EXPECT_DOUBLE_EQ(law.slidingCoefficient(1), kMuS);  // per node
+  law.onUnstick(0);
+  EXPECT_DOUBLE_EQ(law.slidingCoefficient(0), kMuS);
+}
+
+TEST(LinearSlipWeakening, ZeroLengthIsAmontonsCoulomb) {
+  LinearSlipWeakening law(kMuS, kMuK, 0.0);
+  law.resize(1);
+  law.onUnstick(0);
+  EXPECT_DOUBLE_EQ(law.slidingCoefficient(0), kMuK);
+}
+
+TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuousForce) {
+  Scene scene;
+  scene.model = ModelKind::Chain1D;
+  scene.chain.blocks = 1;
+  const Chain1D block(scene);
+  const double k_t = 1000.0;
+  ContactInterface contact(std::make_unique<AmontonsCoulomb>(kMuS, kMuK), block, k_t);
+  Vector u = Vector::Zero(1), v = Vector::Zero(1), force(1);
+  contact.reset(u);
+  ForceEvaluation raw;
+  raw.force = Vector::Constant(1, 2.0);
+  raw.normal_force = Vector::Constant(1, 10.0);
+  u[0] = 3e-3;  // anchor spring force −3 N, within µ_s·N = 4 N
+  force = raw.force;
+  contact.applyFriction(raw, u, force);
+  EXPECT_DOUBLE_EQ(contact.frictionForce(0), -3.0);
+  EXPECT_FALSE(contact.updateStates(raw, u, v, 0.0, 1.0));
+  EXPECT_DOUBLE_EQ(contact.anchorEnergy(u), 0.5 * k_t * 9e-6);
+  u[0] = 5e-3;  // −5 N needed: unsticks
+  EXPECT_TRUE(contact.updateStates(raw, u, v, 0.0, 1.0));
+  force = raw.force;
+  contact.applyFriction(raw, u, force);
+  EXPECT_DOUBLE_EQ(contact.frictionForce(0), -kMuK * 10.0);
+  contact.beginStep(u, v);
+  contact.finishStep(u, v, 1e-3);
+  v[0] = 1.0;
+  contact.beginStep(u, v);
+  v[0] = -1.0;
+  ASSERT_TRUE(contact.finishStep(u, v, 1e-3));
+  force = raw.force;
+  contact.applyFriction(raw, u, force);
+  EXPECT_NEAR(contact.frictionForce(0), -kMuK * 10.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace friction

@@ -1,1 +1,197 @@
+// Whole runs: the 1D side-driven chain end to end against the force balance of MODEL.md §7.7, the
+// energy budget with everything on, determinism, the loading protocol and the stage program.
 #include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "friction_sim/simulation.h"
+#include "test_helpers.h"
+
+namespace friction {
+namespace {
+
+using testing::scenePath;
+
+/// A coarse 2D slider (29 × 16 nodes, l = 5 mm) driven ten times faster than the default, so that a
+/// whole run to the first global event takes about a second.
+Scene coarseSliderScene() {
+  Scene scene = loadScene(scenePath("pmma_2d"));
+  scene.lattice.nodes_x = 29;
+  scene.lattice.nodes_z = 16;
+  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3}};
+  scene.integrator.time_step = 4e-7;
+  return scene;
+}
+
+class SideDrivenChain : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    simulation_ = new Simulation(loadScene(scenePath("pmma_1d_side")));
+    simulation_->run();
+  }
+  static void TearDownTestSuite() { delete simulation_; }
+  static std::vector<const SlipEvent*> precursors() {
+    std::vector<const SlipEvent*> out;
+    for (const SlipEvent& event : simulation_->events()) {
+      if (event.global) break;
+      out.push_back(&event);
+    }
+    return out;
+  }
+  static Simulation* simulation_;
+};
+Simulation* SideDrivenChain::simulation_ = nullptr;
+
+TEST_F(SideDrivenChain, PrecursorsNucleateAtTheTrailingEdgeBeforeOneGlobalEvent) {
+  ASSERT_EQ(simulation_->globalEventCount(), 1);
+  EXPECT_TRUE(simulation_->events().back().global);
+  const auto list = precursors();
+  EXPECT_GE(list.size(), 10u);
+  for (const SlipEvent* event : list) {
+    EXPECT_DOUBLE_EQ(event->nucleation_position, 0.0);
+    EXPECT_DOUBLE_EQ(event->slip_min_x, 0.0);
+    EXPECT_GT(event->end_time, event->onset_time);
+  }
+}
+
+TEST_F(SideDrivenChain, ArrestFrontsFollowTheForceBalance) {
+  // The invading front: each precursor that reaches further than all before it.
+  const double length = simulation_->scene().geometry.length;
+  std::vector<double> shear_ratio, length_ratio;
+  double reach = 0.0;
+  for (const SlipEvent* event : precursors()) {
+    if (event->rupture_length <= reach) continue;
+    reach = event->rupture_length;
+    shear_ratio.push_back(event->onset_shear_force / event->onset_normal_force);
+    length_ratio.push_back(event->rupture_length / length);
+  }
+  ASSERT_GE(shear_ratio.size(), 8u);
+  // L_p/L = (F_X − F_X⁰)/(α µ_k F_Z): a straight line in F_X/F_Z with slope 1/(α µ_k).
+  const int n = static_cast<int>(shear_ratio.size());
+  double mx = 0, my = 0;
+  for (int i = 0; i < n; ++i) {
+    mx += shear_ratio[i] / n;
+    my += length_ratio[i] / n;
+  }
+  double sxx = 0, sxy = 0, syy = 0;
+  for (int i = 0; i < n; ++i) {
+    sxx += (shear_ratio[i] - mx) * (shear_ratio[i] - mx);
+    sxy += (shear_ratio[i] - mx) * (length_ratio[i] - my);
+    syy += (length_ratio[i] - my) * (length_ratio[i] - my);
+  }
+  const double slope = sxy / sxx, intercept = my - slope * mx;
+  const double alpha = 1.0 / (slope * simulation_->scene().friction.kinetic_coefficient);
+  const double offset_ratio = -intercept / slope;  // F_X⁰/F_Z
+  EXPECT_GT(alpha, 0.5);
+  EXPECT_LT(alpha, 1.2);
+  EXPECT_LT(std::abs(offset_ratio), 0.05);
+  EXPECT_GT(sxy * sxy / (sxx * syy), 0.98);
+  for (int i = 0; i < n; ++i) {
+    EXPECT_NEAR(length_ratio[i], slope * shear_ratio[i] + intercept, 0.05) << "precursor " << i;
+  }
+  // Global sliding at λ = 1 comes far below the local µ_s: µ_s,macro ≈ α·µ_k + F_X⁰/F_Z.
+  const SlipEvent& global = simulation_->events().back();
+  const double macro = global.onset_shear_force / global.onset_normal_force;
+  EXPECT_NEAR(macro, (1.0 - intercept) / slope, 0.15 * macro);
+  EXPECT_LT(macro, 0.6 * simulation_->scene().friction.static_coefficient);
+}
+
+TEST_F(SideDrivenChain, EnergyBudgetCloses) {
+  // Verlet with dt = 2e-7 s: the quadratures are O(dt²), re-sticks are interpolated and unsticks
+  // caught up within the step, so what is left is a few parts per million of the work done.
+  const EnergyBudget budget = simulation_->energy();
+  EXPECT_GT(budget.work_in, 0.0);
+  EXPECT_GT(budget.friction_dissipation, 0.0);
+  EXPECT_GT(budget.viscous_dissipation, 0.0);
+  EXPECT_LT(std::abs(budget.relativeResidual()), 1e-5);
+}
+
+TEST(SliderRun, TwoDimensionalEnergyBudgetClosesWithEverythingOn) {
+  for (IntegratorKind scheme : {IntegratorKind::VelocityVerlet, IntegratorKind::RungeKutta4}) {
+    Scene scene = coarseSliderScene();
+    scene.integrator.scheme = scheme;
+    Simulation simulation(scene);
+    simulation.run();
+    ASSERT_EQ(simulation.globalEventCount(), 1);
+    const EnergyBudget budget = simulation.energy();
+    EXPECT_GT(budget.friction_dissipation, 0.1 * budget.work_in);
+    EXPECT_LT(std::abs(budget.relativeResidual()), 1e-4);
+    // Fronts start at the trailing edge: at the pushed row's column or its neighbour (l = 5 mm here).
+    for (const SlipEvent& event : simulation.events()) {
+      if (!event.global) {
+        EXPECT_LE(event.nucleation_position, 2 * 0.005 + 1e-12);
+      }
+    }
+  }
+}
+
+TEST(SliderRun, LoadedEquilibriumCarriesTheNormalLoadWithNoShear) {
+  const Simulation simulation(loadScene(scenePath("pmma_2d")));
+  const LoadCellReading cells = simulation.loadCells();
+  EXPECT_NEAR(cells.interface_normal_sum, 1920.0, 1e-9 * 1920.0);
+  EXPECT_DOUBLE_EQ(cells.shear_force, 0.0);
+  EXPECT_EQ(simulation.velocities().norm(), 0.0);
+  const InterfaceFrame frame = simulation.interfaceFrame();
+  double friction_sum = 0.0;
+  for (double f : frame.friction_force) friction_sum += f;
+  EXPECT_NEAR(friction_sum, 0.0, 1e-9 * 1920.0);
+  // The static solve leaves no force unbalanced: nothing moves in the first steps.
+  Simulation fresh(loadScene(scenePath("pmma_2d")));
+  fresh.stage().command({StageMode::Hold, 0.0, 0.0});
+  for (int i = 0; i < 100; ++i) fresh.step();
+  EXPECT_LT(fresh.velocities().lpNorm<Eigen::Infinity>(), 1e-9);
+}
+
+TEST(SliderRun, SpringMattressCarriesTheNormalLoad) {
+  Scene scene = coarseSliderScene();
+  scene.load.top = TopLoadKind::SpringMattress;
+  const Simulation simulation(scene);
+  EXPECT_NEAR(simulation.loadCells().normal_force, scene.load.normal_force, 1e-9 * scene.load.normal_force);
+  EXPECT_NEAR(simulation.loadCells().interface_normal_sum, scene.load.normal_force, 1e-6 * scene.load.normal_force);
+}
+
+TEST(Determinism, SameSceneTwiceGivesIdenticalEventsAndState) {
+  for (const Scene& scene : {loadScene(scenePath("pmma_1d_side")), coarseSliderScene()}) {
+    Simulation first(scene), second(scene);
+    first.run();
+    second.run();
+    ASSERT_FALSE(first.events().empty());
+    EXPECT_EQ(first.stateHash(), second.stateHash());
+    ASSERT_EQ(first.events().size(), second.events().size());
+    for (std::size_t e = 0; e < first.events().size(); ++e) {
+      EXPECT_EQ(first.events()[e].onset_time, second.events()[e].onset_time);
+      EXPECT_EQ(first.events()[e].node_slip, second.events()[e].node_slip);
+    }
+  }
+}
+
+TEST(StageProgram, HoldThenDriveThenMoveToATarget) {
+  StageSpec spec;
+  spec.program = {StageSegment{StageMode::Hold, 0.0, 0.0, 0.01}, StageSegment{StageMode::Velocity, 1e-3, 0.0, 0.01},
+                  StageSegment{StageMode::Position, 2e-3, 0.0}};
+  Stage stage(spec);
+  const double dt = 1e-4;
+  for (int i = 0; i < 100; ++i) stage.advance(dt);
+  EXPECT_DOUBLE_EQ(stage.position(), 0.0);
+  for (int i = 0; i < 100; ++i) stage.advance(dt);
+  EXPECT_NEAR(stage.position(), 1e-5, 1e-12);
+  EXPECT_NEAR(stage.velocity(), -2e-3, 1e-15);  // heading back to 0
+  for (int i = 0; i < 100; ++i) stage.advance(dt);
+  EXPECT_DOUBLE_EQ(stage.position(), 0.0);
+  EXPECT_DOUBLE_EQ(stage.velocity(), 0.0);
+  EXPECT_NEAR(stage.travel(), 2e-5, 1e-12);
+}
+
+TEST(StageProgram, BadCommandsAreRefusedAndChangeNothing) {
+  Stage stage(StageSpec{});
+  const double speed_before = stage.velocity();
+  EXPECT_NE(stage.command({StageMode::Velocity, std::nan(""), 0.0}).find("finite"), std::string::npos);
+  EXPECT_NE(stage.command({StageMode::Velocity, 5.0, 0.0}).find("max_speed"), std::string::npos);
+  EXPECT_NE(stage.command({StageMode::Position, 0.0, 1e-3}).find("travel speed"), std::string::npos);
+  EXPECT_DOUBLE_EQ(stage.velocity(), speed_before);
+  EXPECT_EQ(stage.command({StageMode::Velocity, -1e-3, 0.0}), "");
+  EXPECT_DOUBLE_EQ(stage.velocity(), -1e-3);
+}
+
+}  // namespace
+}  // namespace friction

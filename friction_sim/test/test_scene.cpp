@@ -1,1 +1,121 @@
+// Scene files: the shipped scenes load, every invalid case is refused with a message naming the field,
+// the value and what is allowed, and a file with several problems lists them all.
 #include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "friction_sim/integrator.h"
+#include "friction_sim/scene_io.h"
+#include "test_helpers.h"
+
+namespace friction {
+namespace {
+
+using testing::scenePath;
+
+std::vector<std::string> problemsOf(const std::string& yaml) {
+  try {
+    parseScene(yaml);
+  } catch (const SceneError& error) {
+    return error.problems();
+  }
+  return {};
+}
+
+bool mentions(const std::vector<std::string>& problems, const std::string& text) {
+  return std::any_of(problems.begin(), problems.end(),
+                     [&](const std::string& p) { return p.find(text) != std::string::npos; });
+}
+
+TEST(SceneFiles, ShippedScenesLoadWithTheirNumbers) {
+  const Scene pmma = loadScene(scenePath("pmma_2d"));
+  EXPECT_EQ(pmma.model, ModelKind::Lattice2D);
+  EXPECT_EQ(pmma.lattice.nodes_x, 57);
+  EXPECT_EQ(pmma.lattice.nodes_z, 31);
+  EXPECT_DOUBLE_EQ(pmma.load.normal_force, 1920.0);
+  EXPECT_DOUBLE_EQ(pmma.pusher.stiffness, 4e6);
+  EXPECT_DOUBLE_EQ(pmma.pusher.height, 0.005);
+  EXPECT_DOUBLE_EQ(pmma.stage.program.front().speed, 4e-4);
+  EXPECT_EQ(loadScene(scenePath("pmma_1d_side")).chain.driving, ChainDriving::Side);
+  EXPECT_EQ(loadScene(scenePath("pmma_1d_top")).chain.driving, ChainDriving::Top);
+  EXPECT_EQ(loadScene(scenePath("single_block")).chain.blocks, 1);
+}
+
+TEST(SceneFiles, WrittenSceneReadsBackIdentically) {
+  const Scene scene = loadScene(scenePath("pmma_2d"));
+  const std::string text = sceneToYaml(scene);
+  EXPECT_EQ(sceneToYaml(parseScene(text)), text);
+}
+
+TEST(SceneFiles, OverridesAreParsedAndValidatedLikeTheFile) {
+  const Scene base = loadScene(scenePath("pmma_2d"));
+  const Scene changed = overrideScene(base, {{"pusher.height", "0.01"}, {"friction.kinetic_coefficient", "0.2"}});
+  EXPECT_DOUBLE_EQ(changed.pusher.height, 0.01);
+  EXPECT_DOUBLE_EQ(changed.friction.kinetic_coefficient, 0.2);
+  EXPECT_THROW(overrideScene(base, {{"pusher.hieght", "0.01"}}), SceneError);
+}
+
+struct InvalidCase {
+  const char* yaml;
+  const char* field;
+  const char* allowed;
+};
+
+class InvalidScene : public ::testing::TestWithParam<InvalidCase> {};
+
+TEST_P(InvalidScene, IsRefusedNamingFieldValueAndRange) {
+  const auto problems = problemsOf(GetParam().yaml);
+  ASSERT_EQ(problems.size(), 1u) << (problems.empty() ? "accepted" : problems.front());
+  EXPECT_NE(problems[0].find(GetParam().field), std::string::npos) << problems[0];
+  EXPECT_NE(problems[0].find(GetParam().allowed), std::string::npos) << problems[0];
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EachProblem, InvalidScene,
+    ::testing::Values(
+        InvalidCase{"friction: {static_coefficient: 0.3, kinetic_coefficient: 0.4}",
+                    "friction.kinetic_coefficient: value 0.4", "mu_k <= mu_s"},
+        InvalidCase{"pusher: {height: 0.08}", "pusher.height: value 0.08", "[0, 0.075]"},
+        InvalidCase{"material: {density: -1200}", "material.density: value -1200", "> 0"},
+        InvalidCase{"pusher: {stiffness: 0}", "pusher.stiffness: value 0", "> 0"},
+        InvalidCase{"lattice: {nodes_x: 57, nodes_z: 30}", "lattice.nodes_z: value 30", "square lattice"},
+        InvalidCase{"instruments: {gauge_height: 0.1}", "instruments.gauge_height: value 0.1", "inside the slider"},
+        InvalidCase{"integrator: {time_step: 1.0e-5}", "integrator.time_step: value 1e-05",
+                    "stability limit of this scene"},
+        InvalidCase{"model: chain_1d\nchain: {tilt: -1.5}", "normal force of block", "w_i > 0"},
+        InvalidCase{"model: chain_1d\nchain: {torque_share: 1.0}\npusher: {height: 0.075}", "at F_X = 768 N", "w_i > 0"},
+        InvalidCase{"frictoin: {law: amontons_coulomb}", "frictoin: unknown key", "allowed keys here"},
+        InvalidCase{"friction: {mu_s: 0.4}", "friction.mu_s: unknown key", "static_coefficient"},
+        InvalidCase{"friction: {law: coulomb}", "friction.law: value 'coulomb'", "amontons_coulomb | slip_weakening"},
+        InvalidCase{"lattice: {nodes_x: many}", "lattice.nodes_x: value 'many'", "integer"},
+        InvalidCase{"stage: {program: [{mode: velocity, speed: 5.0}]}", "stage.program[0].speed: value 5",
+                    "stage.max_speed"},
+        InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [1.0, 2.0]}",
+                    "chain.initial_shear (length): value 2", "one force per block"}));
+
+TEST(InvalidScene, UnstableTimeStepMessageGivesTheLimit) {
+  const auto problems = problemsOf("integrator: {time_step: 1.0e-5}");
+  ASSERT_EQ(problems.size(), 1u);
+  const double limit = sceneStabilityLimit(loadScene(scenePath("pmma_2d")));
+  std::ostringstream text;
+  text.precision(4);
+  text << "dt < " << limit << " s";
+  EXPECT_NE(problems[0].find(text.str()), std::string::npos) << problems[0];
+}
+
+TEST(InvalidScene, EveryProblemOfAFileIsListedAtOnce) {
+  const auto problems = problemsOf(
+      "geometry: {length: -0.14}\n"
+      "friction: {static_coefficient: 0.3, kinetic_coefficient: 0.5, typo: 1}\n"
+      "load: {normal_force: -5}\n"
+      "integrator: {scheme: euler}\n");
+  EXPECT_EQ(problems.size(), 5u);
+  EXPECT_TRUE(mentions(problems, "geometry.length"));
+  EXPECT_TRUE(mentions(problems, "friction.kinetic_coefficient"));
+  EXPECT_TRUE(mentions(problems, "friction.typo: unknown key"));
+  EXPECT_TRUE(mentions(problems, "load.normal_force"));
+  EXPECT_TRUE(mentions(problems, "integrator.scheme: value 'euler'"));
+}
+
+}  // namespace
+}  // namespace friction

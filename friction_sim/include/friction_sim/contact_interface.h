@@ -37,9 +37,11 @@ class ContactInterface {
   /// After the integrator's step: stops nodes whose velocity passed through zero at the interpolated
   /// crossing, accounts friction dissipation and slip. Returns true if any node re-stuck.
   bool finishStep(Vector& u, Vector& v, double dt);
-  /// After the last force evaluation of a step: loss and return of contact, unsticking. Returns true
-  /// if any node changed state (its friction must then be re-applied).
-  bool updateStates(const ForceEvaluation& raw, const Vector& u, const Vector& v);
+  /// After the last force evaluation of a step of length dt: loss and return of contact, unsticking.
+  /// A node that crossed its threshold at a fraction s of the step is given the motion it would have
+  /// made sliding for the rest of the step, (1 − s)·dt, so that slip starts on time rather than up to
+  /// a step late. Returns true if any node changed state (its friction must then be re-applied).
+  bool updateStates(const ForceEvaluation& raw, Vector& u, Vector& v, double dt, double node_mass);
 
   int size() const { return static_cast<int>(state_.size()); }
   ContactState state(int node) const { return state_[node]; }
@@ -49,6 +51,11 @@ class ContactInterface {
   double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m
   /// Nodes that unstuck (or slid off on returning contact) at the end of the last step.
   const std::vector<int>& unstuckLastStep() const { return unstuck_last_step_; }
+  /// Nodes that re-stuck during the last step.
+  const std::vector<int>& restuckLastStep() const { return restuck_last_step_; }
+  /// Fraction of the last step (0..1) at which `node` crossed its threshold (unstuck) or its velocity
+  /// crossed zero (re-stuck), interpolated linearly, so that event times are not quantised by dt.
+  double transitionFraction(int node) const { return transition_fraction_[node]; }
   /// J, energy dissipated by friction since reset (includes energy released by k_T anchors).
   double frictionDissipation() const { return dissipation_; }
   /// J, energy stored in the k_T anchor springs.
@@ -72,7 +79,9 @@ class ContactInterface {
   std::vector<double> other_force_;  ///< N, tangential force on the node from everything but friction
   std::vector<double> slip_origin_;  ///< m
   std::vector<char> just_unstuck_;
-  std::vector<int> unstuck_last_step_;
+  std::vector<int> unstuck_last_step_, restuck_last_step_;
+  std::vector<double> transition_fraction_;
+  std::vector<double> load_ratio_;  ///< |force needed to stick| / (µ_s·N) at the end of the last step
   // Start-of-step copies for re-stick interpolation and dissipation.
   std::vector<double> start_u_, start_v_, start_friction_;
   std::vector<ContactState> start_state_;

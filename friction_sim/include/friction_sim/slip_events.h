@@ -11,11 +11,11 @@ namespace friction {
 
 struct SlipEvent {
   int index = 0;                 ///< 0-based order of the event in the run
-  double onset_time = 0.0;       ///< s
-  double end_time = 0.0;         ///< s
-  double onset_shear_force = 0.0;   ///< N, F_X at onset
+  double onset_time = 0.0;       ///< s, first threshold crossing, interpolated within the step
+  double end_time = 0.0;         ///< s, last re-stick, interpolated within the step
+  double onset_shear_force = 0.0;   ///< N, F_X at onset (interpolated within the step)
   double onset_normal_force = 0.0;  ///< N, F_Z at onset
-  double end_shear_force = 0.0;     ///< N, F_X at the end
+  double end_shear_force = 0.0;     ///< N, F_X at the end (interpolated within the step)
   double nucleation_position = 0.0;  ///< m, mean x of the nodes that unstuck first
   double slip_min_x = 0.0;          ///< m, smallest x of a node that slipped
   double slip_max_x = 0.0;          ///< m, largest x of a node that slipped
@@ -30,16 +30,22 @@ class SlipEventDetector {
  public:
   SlipEventDetector(const Model& model, int front_fit_nodes);
 
-  /// Call after every step with the interface's new states. Returns true when an event has just ended
-  /// (then `events().back()` is it).
-  bool update(double time, const ContactInterface& contact, const Vector& u, double shear_force,
-              double normal_force);
+  /// The load cells over the step just taken: F_X at its start and end, F_Z.
+  struct StepLoads {
+    double shear_start = 0.0;  ///< N
+    double shear_end = 0.0;    ///< N
+    double normal = 0.0;       ///< N
+  };
+  /// Call after every step (from step_start to step_start + dt) with the interface's new states.
+  /// Returns true when an event has just ended (then `events().back()` is it).
+  bool update(double step_start, double dt, const ContactInterface& contact, const Vector& u,
+              const StepLoads& loads);
   bool inEvent() const { return in_event_; }
   const std::vector<SlipEvent>& events() const { return events_; }
   int globalEventCount() const { return global_count_; }
 
  private:
-  void finish(double time, const Vector& u, double shear_force);
+  void finish(double end_time, const Vector& u, double end_shear_force);
 
   std::vector<double> positions_;
   std::vector<int> dofs_;

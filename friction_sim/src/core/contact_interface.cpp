@@ -19,6 +19,8 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
   other_force_.assign(n, 0.0);
   slip_origin_.assign(n, 0.0);
   just_unstuck_.assign(n, 0);
+  transition_fraction_.assign(n, 1.0);
+  load_ratio_.assign(n, 0.0);
   start_u_.assign(n, 0.0);
   start_v_.assign(n, 0.0);
   start_friction_.assign(n, 0.0);
@@ -31,9 +33,11 @@ void ContactInterface::reset(const Vector& u) {
     anchor_[node] = u[dofs_[node]];
     slip_origin_[node] = u[dofs_[node]];
     just_unstuck_[node] = 0;
+    load_ratio_[node] = 0.0;
   }
   law_->resize(size());
   unstuck_last_step_.clear();
+  restuck_last_step_.clear();
   dissipation_ = 0.0;
 }
 
@@ -59,6 +63,7 @@ void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u
 }
 
 void ContactInterface::beginStep(const Vector& u, const Vector& v) {
+  restuck_last_step_.clear();
   for (int node = 0; node < size(); ++node) {
     start_u_[node] = u[dofs_[node]];
     start_v_[node] = v[dofs_[node]];
@@ -80,6 +85,9 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
       u[dof] = start_u_[node] + 0.5 * start_v_[node] * fraction * dt;
       v[dof] = 0.0;
       state_[node] = ContactState::Stuck;
+      transition_fraction_[node] = fraction;
+      load_ratio_[node] = 0.0;
+      restuck_last_step_.push_back(node);
       if (k_t_ > 0.0) {
         // Place the anchor so that the friction force is continuous; that spring energy has to come
         // from somewhere in the bookkeeping, and friction is where the model puts it.
@@ -101,6 +109,7 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
 void ContactInterface::stick(int node, const Vector& u) {
   state_[node] = ContactState::Stuck;
   anchor_[node] = u[dofs_[node]];
+  load_ratio_[node] = 0.0;
 }
 
 void ContactInterface::startSliding(int node, int direction) {
@@ -111,7 +120,8 @@ void ContactInterface::startSliding(int node, int direction) {
   unstuck_last_step_.push_back(node);
 }
 
-bool ContactInterface::updateStates(const ForceEvaluation& raw, const Vector& u, const Vector& v) {
+bool ContactInterface::updateStates(const ForceEvaluation& raw, Vector& u, Vector& v, double dt,
+                                    double node_mass) {
   unstuck_last_step_.clear();
   bool changed = false;
   for (int node = 0; node < size(); ++node) {
@@ -136,10 +146,22 @@ bool ContactInterface::updateStates(const ForceEvaluation& raw, const Vector& u,
     }
     if (state_[node] != ContactState::Stuck) continue;
     const double needed = k_t_ > 0.0 ? k_t_ * (anchor_[node] - u[dof]) : -raw.force[dof];
-    if (std::abs(needed) > law_->staticCoefficient(node) * normal) {
+    const double ratio = std::abs(needed) / (law_->staticCoefficient(node) * normal);
+    const double previous_ratio = load_ratio_[node];
+    load_ratio_[node] = ratio;
+    if (ratio > 1.0) {
+      transition_fraction_[node] =
+          previous_ratio < 1.0 ? std::clamp((1.0 - previous_ratio) / (ratio - previous_ratio), 0.0, 1.0) : 0.0;
       // The spring energy of an elastic anchor is released into the slip.
       dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
       startSliding(node, needed > 0.0 ? -1 : 1);
+      const double late = (1.0 - transition_fraction_[node]) * dt;
+      const double sliding_friction = -law_->slidingCoefficient(node) * normal * direction_[node];
+      const double acceleration = (raw.force[dof] + sliding_friction) / node_mass;
+      const double catch_up = 0.5 * acceleration * late * late;
+      u[dof] += catch_up;
+      v[dof] += acceleration * late;
+      dissipation_ -= sliding_friction * catch_up;
       changed = true;
     }
   }

@@ -97,10 +97,12 @@ double largestEigenvalue(const SparseMatrix& matrix) {
 }  // namespace
 
 double stabilityLimit(IntegratorKind kind, double omega_max, double damping_rate) {
-  if (omega_max <= 0.0 && damping_rate <= 0.0) return std::numeric_limits<double>::infinity();
-  const double scale = 1.0 / std::max(omega_max, damping_rate);
-  auto stable = [&](double dt) { return spectralRadius(kind, omega_max, damping_rate, dt) <= 1.0 + 1e-9; };
-  double low = 0.0, high = scale;
+  if (omega_max <= 0.0) return std::numeric_limits<double>::infinity();
+  // Work in units of 1/ω: the amplification matrix then has entries of order one and its eigenvalues
+  // are not swamped by round-off.
+  const double relative_damping = damping_rate / omega_max;
+  auto stable = [&](double dt) { return spectralRadius(kind, 1.0, relative_damping, dt) <= 1.0 + 1e-9; };
+  double low = 0.0, high = 1.0;
   while (stable(high)) {
     low = high;
     high *= 1.5;
@@ -109,7 +111,7 @@ double stabilityLimit(IntegratorKind kind, double omega_max, double damping_rate
     const double mid = 0.5 * (low + high);
     (stable(mid) ? low : high) = mid;
   }
-  return low;
+  return low / omega_max;
 }
 
 ModeBounds modeBounds(const Model& model, double interfacial_stiffness) {

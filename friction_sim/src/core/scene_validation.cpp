@@ -134,17 +134,18 @@ std::vector<std::string> validateScene(const Scene& s) {
   // Cross-field checks that need a consistent model.
   if (!lattice) {
     const Chain1D chain(s);
-    // F_X stays between 0 and the interface's total static friction µ_s·F_Z.
+    // F_X stays between 0 and the interface's total static friction µ_s·F_Z; w_i is linear in F_X.
+    bool reported = false;
     for (double shear : {0.0, mu_s * s.load.normal_force}) {
       const std::vector<double> w = chain.normalForces(shear);
-      for (std::size_t i = 0; i < w.size(); ++i) {
+      for (std::size_t i = 0; i < w.size() && !reported; ++i) {
         if (w[i] > 0.0) continue;
         std::ostringstream text;
         text << "chain.tilt/chain.torque_share: the normal force of block " << i << " would be " << w[i]
              << " N at F_X = " << shear << " N; allowed: every block's normal force w_i > 0 for F_X in [0, "
              << mu_s * s.load.normal_force << "] N (reduce tilt, torque_share or pusher.height)";
         check.problems.push_back(text.str());
-        break;
+        reported = true;
       }
     }
   }

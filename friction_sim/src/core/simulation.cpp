@@ -90,7 +90,7 @@ void Simulation::relaxToLoadedEquilibrium() {
   contact_.reset(u_);
   external_reference_u_ = u_;
   power_ = acceleration(u_, v_, 0.0, a_);
-  if (contact_.updateStates(evaluation_, u_, v_)) reapplyFriction();
+  if (contact_.updateStates(evaluation_, u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
   initial_elastic_ = model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_);
 }
 
@@ -118,8 +118,9 @@ void Simulation::step() {
   ++steps_;
   pusher_work_ += 0.5 * (shear_start + evaluation_.shear_force) * (stage_.position() - stage_start);
   if (contact_.finishStep(u_, v_, dt_)) power_ = acceleration(u_, v_, time_, a_);
-  if (contact_.updateStates(evaluation_, u_, v_)) reapplyFriction();
-  event_ended_ = detector_.update(time_, contact_, u_, evaluation_.shear_force, evaluation_.normal_load);
+  if (contact_.updateStates(evaluation_, u_, v_, dt_, model_->nodeMass())) reapplyFriction();
+  event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_,
+                                 {shear_start, evaluation_.shear_force, evaluation_.normal_load});
   checkStop();
 }
 

@@ -18,17 +18,22 @@ SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes) : 
   onset_u_.resize(positions_.size());
 }
 
-bool SlipEventDetector::update(double time, const ContactInterface& contact, const Vector& u,
-                               double shear_force, double normal_force) {
+bool SlipEventDetector::update(double step_start, double dt, const ContactInterface& contact,
+                               const Vector& u, const StepLoads& loads) {
   const auto& unstuck = contact.unstuckLastStep();
+  auto transition_time = [&](int node) { return step_start + contact.transitionFraction(node) * dt; };
+  auto shear_at = [&](double time) {
+    return loads.shear_start + (loads.shear_end - loads.shear_start) * (time - step_start) / dt;
+  };
   if (!in_event_ && !unstuck.empty()) {
     in_event_ = true;
     const std::size_t n = positions_.size();
     current_ = SlipEvent{};
     current_.index = static_cast<int>(events_.size());
-    current_.onset_time = time;
-    current_.onset_shear_force = shear_force;
-    current_.onset_normal_force = normal_force;
+    current_.onset_time = step_start + dt;
+    for (int node : unstuck) current_.onset_time = std::min(current_.onset_time, transition_time(node));
+    current_.onset_shear_force = shear_at(current_.onset_time);
+    current_.onset_normal_force = loads.normal;
     current_.first_unstick_time.assign(n, kNaN);
     double sum = 0.0;
     for (int node : unstuck) sum += positions_[node];
@@ -37,18 +42,20 @@ bool SlipEventDetector::update(double time, const ContactInterface& contact, con
   }
   if (!in_event_) return false;
   for (int node : unstuck) {
-    if (std::isnan(current_.first_unstick_time[node])) current_.first_unstick_time[node] = time;
+    if (std::isnan(current_.first_unstick_time[node])) current_.first_unstick_time[node] = transition_time(node);
   }
   if (contact.slidingCount() > 0) return false;
-  finish(time, u, shear_force);
+  double end_time = contact.restuckLastStep().empty() ? step_start + dt : step_start;
+  for (int node : contact.restuckLastStep()) end_time = std::max(end_time, transition_time(node));
+  finish(end_time, u, shear_at(end_time));
   return true;
 }
 
-void SlipEventDetector::finish(double time, const Vector& u, double shear_force) {
+void SlipEventDetector::finish(double end_time, const Vector& u, double end_shear_force) {
   in_event_ = false;
   SlipEvent& event = current_;
-  event.end_time = time;
-  event.end_shear_force = shear_force;
+  event.end_time = end_time;
+  event.end_shear_force = end_shear_force;
   const std::size_t n = positions_.size();
   event.node_slip.resize(n);
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;

@@ -61,7 +61,8 @@ void Stage::advance(double dt) {
   position_ = next;
   if (!following_program_) return;
   segment_elapsed_ += dt;
-  if (segment_elapsed_ >= spec_.program[segment_].duration && segment_ + 1 < spec_.program.size()) {
+  // Switch on the step that ends nearest to the segment's end, immune to round-off in the sum.
+  if (segment_elapsed_ + 0.5 * dt >= spec_.program[segment_].duration && segment_ + 1 < spec_.program.size()) {
     enterSegment(segment_ + 1);
   }
 }
