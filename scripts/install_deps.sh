@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs what the rig needs to build, test and run; does nothing when everything is there.
+#   Debian 12 (bookworm) and other systems without /opt/ros: Debian's own ROS 1 packages.
+#   Ubuntu 20.04 with /opt/ros/noetic (packages.ros.org): the ros-noetic-* packages.
+# Runs as root, or through sudo when not root.
+set -euo pipefail
+
+common=(build-essential cmake libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev
+        python3-matplotlib xvfb xauth imagemagick)
+if [ -d /opt/ros/noetic ]; then
+  ros=(ros-noetic-catkin ros-noetic-roscpp ros-noetic-rosbag ros-noetic-rostest ros-noetic-roslaunch
+       ros-noetic-std-msgs ros-noetic-geometry-msgs ros-noetic-visualization-msgs ros-noetic-rosgraph-msgs
+       ros-noetic-message-generation ros-noetic-message-runtime ros-noetic-rviz python3-catkin-pkg)
+else
+  ros=(catkin python3-catkin-pkg ros-core-dev librosbag-dev python3-rosbag python3-rostest python3-roslaunch
+       rosbash ros-message-generation libstd-msgs-dev libgeometry-msgs-dev libvisualization-msgs-dev
+       libros-rosgraph-msgs-dev librviz-dev)
+fi
+
+missing=()
+for package in "${common[@]}" "${ros[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: everything is installed"
+  exit 0
+fi
+
+as_root=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install_deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  as_root=(sudo)
+fi
+echo "install_deps: installing ${missing[*]}"
+"${as_root[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The README's test command: installs what is missing, builds, runs every test of every package and
+# ends with one line "N passed, N failed". Exits non-zero if anything failed or did not run.
+set -uo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+"$here/scripts/install_deps.sh" || exit 1
+"$here/scripts/build.sh" -j2 || { echo "0 passed, 1 failed"; exit 1; }
+source "$here/scripts/ros_env.sh"
+results="$RIG_WS/build/test_results"
+rm -rf "$results"
+# catkin_make run_tests exits 0 even when tests fail: the verdict comes from catkin_test_results.
+catkin_make -C "$RIG_WS" --source "$RIG_ROOT" run_tests -j2 >"$RIG_WS/run_tests.log" 2>&1 || {
+  tail -n 50 "$RIG_WS/run_tests.log"
+  echo "0 passed, 1 failed"
+  exit 1
+}
+# catkin_test_results decides pass/fail; count_results.py counts (catkin's summary counts gtest twice).
+catkin_test_results "$results" >/dev/null 2>&1
+verdict=$?
+catkin_test_results --all "$results" 2>&1 | grep -E 'FAILURE|ERROR|Failure|failed' | head -n 40 || true
+/usr/bin/python3 "$RIG_ROOT/tests/count_results.py" "$results"
+counted=$?
+[ "$verdict" -eq 0 ] && [ "$counted" -eq 0 ]
