@@ -1,5 +1,6 @@
 // Every check a scene must pass before a run starts, in one place.
 #include <cmath>
+#include <initializer_list>
 #include <sstream>
 
 #include "friction_sim/chain_1d.h"
@@ -30,6 +31,15 @@ class Checker {
     std::ostringstream allowed;
     allowed << "[" << low << ", " << high << "] (" << what << ")";
     require(value >= low && value <= high, field, value, allowed.str());
+  }
+  /// True if no problem so far concerns a field starting with one of `prefixes`.
+  bool clean(std::initializer_list<const char*> prefixes) const {
+    for (const auto& problem : problems) {
+      for (const char* prefix : prefixes) {
+        if (problem.rfind(prefix, 0) == 0) return false;
+      }
+    }
+    return true;
   }
   std::vector<std::string> problems;
 };
@@ -129,10 +139,12 @@ std::vector<std::string> validateScene(const Scene& s) {
   check.require(s.stop.stage_travel > 0.0, "stop.stage_travel", s.stop.stage_travel, "a travel > 0 m (.inf allowed)");
   check.positive("integrator.time_step", s.integrator.time_step);
 
-  if (!check.problems.empty()) return check.problems;
-
-  // Cross-field checks that need a consistent model.
-  if (!lattice) {
+  // Cross-field checks that need a consistent model; run whenever the fields they use are valid, so
+  // that one refusal lists everything.
+  const bool model_valid = check.clean({"geometry.", "material.", "lattice.", "chain.", "pusher.", "load.",
+                                        "friction.interfacial_stiffness", "integrator."});
+  if (!model_valid) return check.problems;
+  if (!lattice && check.clean({"friction.static_coefficient"})) {
     const Chain1D chain(s);
     // F_X stays between 0 and the interface's total static friction µ_s·F_Z; w_i is linear in F_X.
     bool reported = false;
