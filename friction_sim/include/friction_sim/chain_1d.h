@@ -43,6 +43,10 @@ class Chain1D : public Model {
     return {};  // the chain has no vertical dimension: the interface frame is its only stress reading
   }
   void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const override;
+  std::vector<double> nodeSpeeds(const Vector& v) const override;
+  GaugeStresses nodeStresses(const Vector&) const override;
+  std::array<int, 2> gridShape() const override { return {n_, 1}; }
+  double nodeSpacing() const override { return spacing_; }
 
  private:
   double drivingStiffness(int block) const;

@@ -39,6 +39,20 @@ struct GaugeProfile {
   GaugeStresses stress;
 };
 
+/// The slider's nodes at one instant, for visualisation.
+struct LatticeSnapshot {
+  double time = 0.0;                      ///< s
+  int nodes_x = 0, nodes_z = 0;           ///< grid shape (the chain: N × 1)
+  double spacing = 0.0;                   ///< m, rest spacing
+  std::vector<double> x, z;               ///< m, current node positions
+  std::vector<double> speed;              ///< m/s
+  GaugeStresses stress;                   ///< Pa, per node
+  std::vector<std::uint8_t> interface_state;  ///< per interface node, as in InterfaceFrame
+  double stage_position = 0.0;            ///< m
+  double pusher_height = 0.0;             ///< m
+  double normal_force = 0.0;              ///< N
+};
+
 /// Energy budget since the loaded equilibrium: work in = Δelastic + Δkinetic + dissipated.
 struct EnergyBudget {
   double work_in = 0.0;               ///< J, by the pusher's stage and the top load

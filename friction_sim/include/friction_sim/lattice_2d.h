@@ -47,6 +47,10 @@ class Lattice2D : public Model {
   GaugeStresses gaugeStresses(const Vector& u, double height,
                               const std::vector<double>& positions) const override;
   void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const override;
+  std::vector<double> nodeSpeeds(const Vector& v) const override;
+  GaugeStresses nodeStresses(const Vector& u) const override;
+  std::array<int, 2> gridShape() const override { return {nx_, nz_}; }
+  double nodeSpacing() const override { return spacing_; }
 
   /// Pa, cell-average (virial) stress of cell (i, j) spanning nodes i..i+1, j..j+1, from the spring
   /// forces: σ = (1/(l²B)) Σ w·T·r̂⊗r, edges weighted ½ (shared with the neighbour cell), diagonals 1.

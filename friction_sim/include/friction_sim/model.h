@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -81,6 +82,14 @@ class Model {
 
   /// Node positions (rest + displacement) for visualisation: x then z per node.
   virtual void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const = 0;
+  /// m/s, speed of every node.
+  virtual std::vector<double> nodeSpeeds(const Vector& v) const = 0;
+  /// Stress at every node (mean of the cells around it; zero for the chain, which has no cells).
+  virtual GaugeStresses nodeStresses(const Vector& u) const = 0;
+  /// Nodes along x and along z (the chain: N × 1).
+  virtual std::array<int, 2> gridShape() const = 0;
+  /// m, rest spacing of the nodes (l or a).
+  virtual double nodeSpacing() const = 0;
 };
 
 std::unique_ptr<Model> buildModel(const Scene& scene);

@@ -8,18 +8,15 @@
 #include <vector>
 
 #include "friction_sim/scene.h"
+#include "friction_sim/yaml_fields.h"
 
 namespace friction {
 
 /// Thrown when a scene is refused; `problems()` holds one message per problem, each naming the
 /// field, the value and what is allowed.
-class SceneError : public std::runtime_error {
+class SceneError : public ConfigError {
  public:
-  explicit SceneError(std::vector<std::string> problems);
-  const std::vector<std::string>& problems() const { return problems_; }
-
- private:
-  std::vector<std::string> problems_;
+  explicit SceneError(std::vector<std::string> problems) : ConfigError("scene", std::move(problems)) {}
 };
 
 /// Parses a scene from YAML text; fields absent from the text keep the defaults of `base`.

@@ -40,10 +40,15 @@ class Simulation : public Dynamics {
   LoadCellReading loadCells() const;
   InterfaceFrame interfaceFrame() const;
   GaugeProfile gaugeProfile() const;
+  LatticeSnapshot snapshot() const;
   EnergyBudget energy() const;
   const std::vector<SlipEvent>& events() const { return detector_.events(); }
   /// True if the last step ended a slip event (events().back()).
   bool eventEndedLastStep() const { return event_ended_; }
+  /// True if a slip event started in the last step.
+  bool eventStartedLastStep() const { return event_started_; }
+  /// True while a slip event is under way.
+  bool inEvent() const { return detector_.inEvent(); }
   int globalEventCount() const { return detector_.globalEventCount(); }
 
   /// Stage commands from a controller replace the scene's stage program.
@@ -82,6 +87,7 @@ class Simulation : public Dynamics {
   double power_ = 0.0;  ///< W, viscous power at the current state
   ForceEvaluation evaluation_;  ///< the last force evaluation (friction excluded)
   bool event_ended_ = false;
+  bool event_started_ = false;
   std::string stop_reason_;
   // Energy bookkeeping.
   double initial_elastic_ = 0.0;

@@ -130,4 +130,18 @@ void Chain1D::nodePositions(const Vector& u, std::vector<double>& x, std::vector
   for (int i = 0; i < n_; ++i) x[i] = i * spacing_ + u[i];
 }
 
+std::vector<double> Chain1D::nodeSpeeds(const Vector& v) const {
+  std::vector<double> speed(n_);
+  for (int i = 0; i < n_; ++i) speed[i] = std::abs(v[i]);
+  return speed;
+}
+
+GaugeStresses Chain1D::nodeStresses(const Vector&) const {
+  GaugeStresses zero;
+  zero.sigma_xx.assign(n_, 0.0);
+  zero.sigma_zz.assign(n_, 0.0);
+  zero.tau_xz.assign(n_, 0.0);
+  return zero;
+}
+
 }  // namespace friction

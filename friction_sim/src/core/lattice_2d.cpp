@@ -332,4 +332,35 @@ void Lattice2D::nodePositions(const Vector& u, std::vector<double>& x, std::vect
   }
 }
 
+std::vector<double> Lattice2D::nodeSpeeds(const Vector& v) const {
+  std::vector<double> speed(n_);
+  for (int node = 0; node < n_; ++node) speed[node] = std::hypot(v[xDof(node)], v[zDof(node)]);
+  return speed;
+}
+
+GaugeStresses Lattice2D::nodeStresses(const Vector& u) const {
+  GaugeStresses out;
+  out.sigma_xx.assign(n_, 0.0);
+  out.sigma_zz.assign(n_, 0.0);
+  out.tau_xz.assign(n_, 0.0);
+  std::vector<int> cells(n_, 0);
+  for (int j = 0; j + 1 < nz_; ++j) {
+    for (int i = 0; i + 1 < nx_; ++i) {
+      const auto stress = cellStress(u, i, j);
+      for (int node : {nodeIndex(i, j), nodeIndex(i + 1, j), nodeIndex(i, j + 1), nodeIndex(i + 1, j + 1)}) {
+        out.sigma_xx[node] += stress[0];
+        out.sigma_zz[node] += stress[1];
+        out.tau_xz[node] += stress[2];
+        ++cells[node];
+      }
+    }
+  }
+  for (int node = 0; node < n_; ++node) {
+    out.sigma_xx[node] /= cells[node];
+    out.sigma_zz[node] /= cells[node];
+    out.tau_xz[node] /= cells[node];
+  }
+  return out;
+}
+
 }  // namespace friction

@@ -1,5 +1,7 @@
 #include "friction_sim/scene_io.h"
 
+#include "friction_sim/yaml_fields.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -12,11 +14,7 @@
 
 namespace friction {
 
-namespace {
-
-template <class E>
-using EnumTable = std::vector<std::pair<E, const char*>>;
-
+// Names of the scene's enum values in YAML (found by YamlFieldReader through ADL).
 const EnumTable<ModelKind> kModelNames{{ModelKind::Lattice2D, "lattice_2d"},
                                        {ModelKind::Chain1D, "chain_1d"}};
 const EnumTable<SpringForm> kSpringFormNames{{SpringForm::Geometric, "geometric"},
@@ -40,12 +38,8 @@ const EnumTable<FrictionLawKind>& enumTable(FrictionLawKind) { return kLawNames;
 const EnumTable<IntegratorKind>& enumTable(IntegratorKind) { return kSchemeNames; }
 const EnumTable<StageMode>& enumTable(StageMode) { return kStageModeNames; }
 
-template <class E>
-std::string allowedNames(const EnumTable<E>& table) {
-  std::string out;
-  for (const auto& entry : table) out += (out.empty() ? "" : " | ") + std::string(entry.second);
-  return out;
-}
+
+namespace {
 
 std::string formatNumber(double value) {
   std::ostringstream text;
@@ -128,131 +122,6 @@ void visitScene(Scene& s, Visitor& v) {
   });
 }
 
-class YamlReader {
- public:
-  YamlReader(const YAML::Node& root, std::vector<std::string>& problems)
-      : node_(root), problems_(problems) {}
-
-  template <class T>
-  void field(const char* key, T& value) {
-    used_.insert(key);
-    const YAML::Node child = node_[key];
-    if (!child) return;
-    read(child, path(key), value);
-  }
-
-  void section(const char* key, const std::function<void()>& body) {
-    used_.insert(key);
-    const YAML::Node child = node_[key];
-    if (!child) return;
-    if (!child.IsMap()) {
-      problems_.push_back(path(key) + ": expected a mapping of fields");
-      return;
-    }
-    enter(child, path(key), body);
-  }
-
-  template <class T, class Body>
-  void list(const char* key, std::vector<T>& items, Body&& body) {
-    used_.insert(key);
-    const YAML::Node child = node_[key];
-    if (!child) return;
-    if (!child.IsSequence() || child.size() == 0) {
-      problems_.push_back(path(key) + ": expected a non-empty list");
-      return;
-    }
-    items.assign(child.size(), T{});
-    for (std::size_t i = 0; i < child.size(); ++i) {
-      const std::string item_path = path(key) + "[" + std::to_string(i) + "]";
-      if (!child[i].IsMap()) {
-        problems_.push_back(item_path + ": expected a mapping of fields");
-        continue;
-      }
-      enter(child[i], item_path, [&] { body(items[i]); });
-    }
-  }
-
-  /// Reports every key of the current mapping that no field claimed.
-  void rejectUnknownKeys() {
-    for (const auto& entry : node_) {
-      const std::string key = entry.first.as<std::string>();
-      if (!used_.count(key)) {
-        std::string allowed;
-        for (const auto& name : used_) allowed += (allowed.empty() ? "" : ", ") + name;
-        problems_.push_back(path(key) + ": unknown key; allowed keys here: " + allowed);
-      }
-    }
-  }
-
- private:
-  void enter(const YAML::Node& child, const std::string& child_path, const std::function<void()>& body) {
-    YAML::Node saved_node = node_;
-    std::string saved_prefix = prefix_;
-    std::set<std::string> saved_used;
-    saved_used.swap(used_);
-    node_.reset(child);
-    prefix_ = child_path + ".";
-    body();
-    rejectUnknownKeys();
-    node_.reset(saved_node);
-    prefix_ = saved_prefix;
-    used_.swap(saved_used);
-  }
-
-  std::string path(const std::string& key) const { return prefix_ + key; }
-
-  void read(const YAML::Node& node, const std::string& where, double& value) {
-    try {
-      value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      problems_.push_back(where + ": value '" + YAML::Dump(node) + "' is not a number");
-    }
-  }
-  void read(const YAML::Node& node, const std::string& where, int& value) {
-    try {
-      value = node.as<int>();
-    } catch (const YAML::Exception&) {
-      problems_.push_back(where + ": value '" + YAML::Dump(node) + "' is not an integer");
-    }
-  }
-  void read(const YAML::Node& node, const std::string& where, std::string& value) {
-    if (!node.IsScalar()) {
-      problems_.push_back(where + ": expected a string");
-      return;
-    }
-    value = node.as<std::string>();
-  }
-  void read(const YAML::Node& node, const std::string& where, std::vector<double>& value) {
-    if (!node.IsSequence()) {
-      problems_.push_back(where + ": expected a list of numbers");
-      return;
-    }
-    value.clear();
-    for (std::size_t i = 0; i < node.size(); ++i) {
-      double item = 0.0;
-      read(node[i], where + "[" + std::to_string(i) + "]", item);
-      value.push_back(item);
-    }
-  }
-  template <class E, class = std::enable_if_t<std::is_enum<E>::value>>
-  void read(const YAML::Node& node, const std::string& where, E& value) {
-    const std::string text = node.IsScalar() ? node.as<std::string>() : YAML::Dump(node);
-    for (const auto& entry : enumTable(E{})) {
-      if (text == entry.second) {
-        value = entry.first;
-        return;
-      }
-    }
-    problems_.push_back(where + ": value '" + text + "' is not allowed; allowed: " +
-                        allowedNames(enumTable(E{})));
-  }
-
-  YAML::Node node_;
-  std::string prefix_;
-  std::set<std::string> used_;
-  std::vector<std::string>& problems_;
-};
-
 class YamlWriter {
  public:
   explicit YamlWriter(YAML::Emitter& out) : out_(out) {}
@@ -305,14 +174,25 @@ class YamlWriter {
 
 }  // namespace
 
-SceneError::SceneError(std::vector<std::string> problems)
+ConfigError::ConfigError(const std::string& what_was_refused, std::vector<std::string> problems)
     : std::runtime_error([&] {
-        std::string text = "scene refused (" + std::to_string(problems.size()) + " problem" +
+        std::string text = what_was_refused + " refused (" + std::to_string(problems.size()) + " problem" +
                            (problems.size() == 1 ? "" : "s") + "):";
         for (const auto& problem : problems) text += "\n  - " + problem;
         return text;
       }()),
       problems_(std::move(problems)) {}
+
+std::string readTextFile(const std::string& path, std::vector<std::string>& problems) {
+  std::ifstream file(path);
+  if (!file) {
+    problems.push_back("file '" + path + "' cannot be read");
+    return {};
+  }
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
 
 Scene parseScene(const std::string& yaml_text, const Scene& base) {
   Scene scene = base;
@@ -324,7 +204,7 @@ Scene parseScene(const std::string& yaml_text, const Scene& base) {
     throw SceneError({std::string("YAML syntax error: ") + error.what()});
   }
   if (!root.IsMap()) throw SceneError({"scene: expected a mapping of sections at the top level"});
-  YamlReader reader(root, problems);
+  YamlFieldReader reader(root, problems);
   visitScene(scene, reader);
   reader.rejectUnknownKeys();
   // Validate even after parse problems so that one refusal lists everything wrong with the file.
@@ -334,11 +214,10 @@ Scene parseScene(const std::string& yaml_text, const Scene& base) {
 }
 
 Scene loadScene(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw SceneError({"scene file '" + path + "' cannot be read"});
-  std::stringstream text;
-  text << file.rdbuf();
-  return parseScene(text.str());
+  std::vector<std::string> problems;
+  const std::string text = readTextFile(path, problems);
+  if (!problems.empty()) throw SceneError(problems);
+  return parseScene(text);
 }
 
 Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides) {

@@ -119,8 +119,10 @@ void Simulation::step() {
   pusher_work_ += 0.5 * (shear_start + evaluation_.shear_force) * (stage_.position() - stage_start);
   if (contact_.finishStep(u_, v_, dt_)) power_ = acceleration(u_, v_, time_, a_);
   if (contact_.updateStates(evaluation_, u_, v_, dt_, model_->nodeMass())) reapplyFriction();
+  const bool was_in_event = detector_.inEvent();
   event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_,
                                  {shear_start, evaluation_.shear_force, evaluation_.normal_load});
+  event_started_ = !was_in_event && (detector_.inEvent() || event_ended_);
   checkStop();
 }
 
@@ -194,6 +196,25 @@ GaugeProfile Simulation::gaugeProfile() const {
   }
   profile.stress = model_->gaugeStresses(u_, profile.height, profile.position);
   return profile;
+}
+
+LatticeSnapshot Simulation::snapshot() const {
+  LatticeSnapshot snapshot;
+  snapshot.time = time_;
+  const auto shape = model_->gridShape();
+  snapshot.nodes_x = shape[0];
+  snapshot.nodes_z = shape[1];
+  snapshot.spacing = model_->nodeSpacing();
+  model_->nodePositions(u_, snapshot.x, snapshot.z);
+  snapshot.speed = model_->nodeSpeeds(v_);
+  snapshot.stress = model_->nodeStresses(u_);
+  for (int node = 0; node < contact_.size(); ++node) {
+    snapshot.interface_state.push_back(static_cast<std::uint8_t>(contact_.state(node)));
+  }
+  snapshot.stage_position = stage_.position();
+  snapshot.pusher_height = scene_.pusher.height;
+  snapshot.normal_force = evaluation_.normal_load;
+  return snapshot;
 }
 
 EnergyBudget Simulation::energy() const {

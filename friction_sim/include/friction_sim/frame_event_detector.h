@@ -1,0 +1,41 @@
+// Slip events seen from the instruments alone (ROS-free core of the precursor detector node): the
+// interface camera's frames and the load cells, as an experimentalist has them. An event starts at a
+// frame with a sliding node after an all-stuck frame and ends at the next all-stuck frame; the slipped
+// nodes are those whose accumulated slip changed between the all-stuck frames around the event.
+// The simulator publishes a frame at every step where an event starts or ends, so none is missed.
+#pragma once
+
+#include <deque>
+#include <optional>
+#include <vector>
+
+#include "friction_sim/instruments.h"
+#include "friction_sim/slip_events.h"
+
+namespace friction {
+
+class FrameEventDetector {
+ public:
+  /// `slider_length` (m) for L_p/L; `front_fit_nodes` as in the scene.
+  FrameEventDetector(double slider_length, int front_fit_nodes);
+
+  /// Load-cell samples, in time order.
+  void addLoadCells(const LoadCellReading& reading);
+  /// Interface frames, in time order. Returns the event that this frame ended, if any.
+  std::optional<SlipEvent> addFrame(const InterfaceFrame& frame);
+  /// Forgets everything (time jumped backwards, e.g. looped playback).
+  void reset();
+
+  double sliderLength() const { return slider_length_; }
+
+ private:
+  double slider_length_;
+  int front_fit_nodes_;
+  int next_index_ = 0;
+  std::deque<LoadCellReading> load_cells_;
+  std::optional<InterfaceFrame> last_stuck_frame_;
+  bool in_event_ = false;
+  SlipEvent current_;
+};
+
+}  // namespace friction

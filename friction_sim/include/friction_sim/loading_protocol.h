@@ -1,0 +1,65 @@
+// The loading protocol a controller runs (ROS-free): ramp F_Z to a target, hold, drive the stage at V,
+// stop and go, move to a position; and when to end the run. Read from YAML, it becomes a schedule of
+// commands, each stamped with the simulated time at which it takes effect, so that a run is
+// deterministic however late the commands travel.
+//
+//   steps:
+//     - {action: normal_load, normal_force: 1920, ramp_time: 0.005}  # N, s
+//     - {action: hold, duration: 0.002}                               # s
+//     - {action: drive, speed: 4.0e-4, duration: .inf}                # m/s, s
+//   end: {global_events: 4, stage_travel: .inf, time: .inf}           # count, m, s
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "friction_sim/stage.h"
+
+namespace friction {
+
+enum class ProtocolAction { NormalLoad, Hold, Drive, MoveTo };
+
+struct ProtocolStep {
+  ProtocolAction action = ProtocolAction::Drive;
+  double normal_force = 0.0;  ///< N, F_Z to reach (normal_load)
+  double ramp_time = 0.0;     ///< s, F_Z changes linearly over this time (normal_load; 0 = at once)
+  double speed = 4.0e-4;      ///< m/s, stage speed (drive, signed) or travel speed (move_to)
+  double target = 0.0;        ///< m, stage position (move_to)
+  double duration = std::numeric_limits<double>::infinity();  ///< s, how long the step lasts (hold, drive, move_to)
+};
+
+struct ProtocolEnd {
+  int global_events = 0;  ///< end after this many global slip events (0 = not this condition)
+  double stage_travel = std::numeric_limits<double>::infinity();  ///< m
+  double time = std::numeric_limits<double>::infinity();          ///< s since the protocol started
+};
+
+struct LoadingProtocol {
+  std::vector<ProtocolStep> steps{ProtocolStep{}};
+  ProtocolEnd end;
+  int ramp_commands = 20;  ///< F_Z commands per ramp
+};
+
+/// A command to the rig at a simulated time.
+struct TimedCommand {
+  enum class Kind { Stage, NormalLoad };
+  double time = 0.0;  ///< s, simulated
+  Kind kind = Kind::Stage;
+  StageCommand stage;
+  double normal_force = 0.0;  ///< N
+};
+
+/// Throws ConfigError listing every problem.
+LoadingProtocol parseProtocol(const std::string& yaml_text);
+LoadingProtocol loadProtocol(const std::string& path);
+
+/// The protocol's commands from `start_time` (s), ramps starting at F_Z = `start_normal_force` (N);
+/// it ends with the first step of infinite duration.
+std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, double start_time,
+                                           double start_normal_force);
+
+/// True once an end condition of the protocol holds.
+bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time);
+
+}  // namespace friction
