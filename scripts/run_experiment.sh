@@ -1,11 +1,20 @@
 #!/usr/bin/env bash
-# The README's main command: installs what is missing, builds, and runs the default experiment
-# (scene pmma_2d, side driving, to the first global slip) with the offline runner.
-# Extra arguments go to friction_run, e.g. --set stop.global_events=3.
+# The README's main command: installs what is missing, builds, runs the default experiment headless
+# (scene pmma_2d, side driving, to the first global slip and three more stick-slip cycles) with the
+# ROS rig on a private localhost master, records a bag, prints the summary and writes the figures.
+#   scripts/run_experiment.sh [roslaunch arg:=value]...   e.g. scene:=$PWD/friction_sim/scenes/pmma_1d_side.yaml
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 "$here/scripts/install_deps.sh"
+echo "building (log in .build.log) ..."
 "$here/scripts/build.sh" -j2 >"$here/.build.log" 2>&1 || { tail -n 40 "$here/.build.log"; exit 1; }
 source "$here/scripts/ros_env.sh"
-scene="${SCENE:-$RIG_ROOT/friction_sim/scenes/pmma_2d.yaml}"
-exec "$RIG_WS/devel/lib/friction_sim/friction_run" "$scene" --out "$RIG_ROOT/results/$(basename "$scene" .yaml)" "$@"
+out="$RIG_ROOT/results/experiment"
+mkdir -p "$out"
+rm -f "$out/run.bag"
+"$RIG_ROOT/scripts/rig_launch.sh" "$RIG_ROOT/launch/rig.launch" record:=true bag:="$out/run.bag" "$@" \
+  2>&1 | grep -vE '^\s*$|killing on exit|shutting down|^\S*\[1m|REQUIRED process|process has finished|log file:|Initiating shutdown|^=+|SUMMARY|PARAMETERS|NODES|auto-starting|^ \* |^    ' || true
+[ -f "$out/run.bag" ] || { echo "run_experiment: no bag was written" >&2; exit 1; }
+set +u; source "$RIG_WS/devel/setup.bash"; set -u
+/usr/bin/python3 "$RIG_ROOT/friction_sim/scripts/rig_report" "$out/run.bag" --out "$out"
+echo "results in $out: run.bag, loading_curve.png, precursors.png, slip_map.png, events.csv"

@@ -21,8 +21,11 @@ class FrameEventDetector {
 
   /// Load-cell samples, in time order.
   void addLoadCells(const LoadCellReading& reading);
-  /// Interface frames, in time order. Returns the event that this frame ended, if any.
-  std::optional<SlipEvent> addFrame(const InterfaceFrame& frame);
+  /// Interface frames, in time order.
+  void addFrame(const InterfaceFrame& frame);
+  /// Events that have ended and whose load-cell readings have arrived (the two topics travel
+  /// separately, so the load cells of an event's last step may come after its last frame).
+  std::vector<SlipEvent> takeCompletedEvents();
   /// Forgets everything (time jumped backwards, e.g. looped playback).
   void reset();
 
@@ -36,6 +39,7 @@ class FrameEventDetector {
   std::optional<InterfaceFrame> last_stuck_frame_;
   bool in_event_ = false;
   SlipEvent current_;
+  std::deque<SlipEvent> ended_;  ///< waiting for their load cells
 };
 
 }  // namespace friction

@@ -21,6 +21,7 @@ class Stage {
   double position() const { return position_; }  ///< m, X_s
   double velocity() const;                        ///< m/s, dX_s/dt now
   double travel() const { return travel_; }       ///< m, total distance moved
+  const StageCommand& current() const { return current_; }  ///< what the stage is doing now
   /// m, where the stage will be `lead` seconds from now if nothing changes (for stages within a step).
   double positionAfter(double lead) const;
 

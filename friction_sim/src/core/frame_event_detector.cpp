@@ -21,22 +21,46 @@ void FrameEventDetector::reset() {
   load_cells_.clear();
   last_stuck_frame_.reset();
   in_event_ = false;
+  ended_.clear();
 }
 
 void FrameEventDetector::addLoadCells(const LoadCellReading& reading) {
   load_cells_.push_back(reading);
-  // Older samples than the last all-stuck frame can no longer be an onset.
-  const double horizon = last_stuck_frame_ ? last_stuck_frame_->time : -std::numeric_limits<double>::infinity();
-  while (load_cells_.size() > 2 && load_cells_[1].time <= horizon) load_cells_.pop_front();
 }
 
-std::optional<SlipEvent> FrameEventDetector::addFrame(const InterfaceFrame& frame) {
+std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents() {
+  std::vector<SlipEvent> ready;
+  const double latest = load_cells_.empty() ? -std::numeric_limits<double>::infinity() : load_cells_.back().time;
+  while (!ended_.empty() && ended_.front().end_time <= latest) {
+    SlipEvent event = std::move(ended_.front());
+    ended_.pop_front();
+    // The last samples taken at or before the onset and the end.
+    for (const LoadCellReading& reading : load_cells_) {
+      if (reading.time <= event.onset_time) {
+        event.onset_shear_force = reading.shear_force;
+        event.onset_normal_force = reading.normal_force;
+      }
+      if (reading.time <= event.end_time) event.end_shear_force = reading.shear_force;
+    }
+    ready.push_back(std::move(event));
+  }
+  // Keep the samples from the last one before any onset still to be resolved: those of ended and
+  // current events, and of an event starting after the last all-stuck frame.
+  double horizon = latest;
+  if (last_stuck_frame_) horizon = std::min(horizon, last_stuck_frame_->time);
+  if (in_event_) horizon = std::min(horizon, current_.onset_time);
+  if (!ended_.empty()) horizon = std::min(horizon, ended_.front().onset_time);
+  while (load_cells_.size() > 1 && load_cells_[1].time <= horizon) load_cells_.pop_front();
+  return ready;
+}
+
+void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   const std::size_t n = frame.position.size();
   const bool sliding = anySliding(frame);
   if (!in_event_) {
     if (!sliding || !last_stuck_frame_ || last_stuck_frame_->position.size() != n) {
       if (!sliding) last_stuck_frame_ = frame;
-      return std::nullopt;
+      return;
     }
     in_event_ = true;
     current_ = SlipEvent{};
@@ -51,12 +75,6 @@ std::optional<SlipEvent> FrameEventDetector::addFrame(const InterfaceFrame& fram
       ++count;
     }
     current_.nucleation_position = sum / count;
-    // The load cells at the onset: the last sample taken at or before the onset frame.
-    for (const LoadCellReading& reading : load_cells_) {
-      if (reading.time > frame.time) break;
-      current_.onset_shear_force = reading.shear_force;
-      current_.onset_normal_force = reading.normal_force;
-    }
   }
   for (std::size_t node = 0; node < n; ++node) {
     if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) &&
@@ -64,15 +82,11 @@ std::optional<SlipEvent> FrameEventDetector::addFrame(const InterfaceFrame& fram
       current_.first_unstick_time[node] = frame.time;
     }
   }
-  if (sliding) return std::nullopt;
+  if (sliding) return;
 
   in_event_ = false;
   SlipEvent event = std::move(current_);
   event.end_time = frame.time;
-  for (const LoadCellReading& reading : load_cells_) {
-    if (reading.time > frame.time) break;
-    event.end_shear_force = reading.shear_force;
-  }
   event.node_slip.resize(n);
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
   std::size_t slipped = 0;
@@ -89,7 +103,7 @@ std::optional<SlipEvent> FrameEventDetector::addFrame(const InterfaceFrame& fram
   event.global = slipped == n;
   event.front_speed = frontSpeeds(frame.position, event.first_unstick_time, front_fit_nodes_);
   last_stuck_frame_ = frame;
-  return event;
+  ended_.push_back(std::move(event));
 }
 
 }  // namespace friction

@@ -1,0 +1,54 @@
+// Core structs to and from the rig's ROS messages. Needs the message headers but no master, so the
+// conversions are unit-tested on their own.
+#pragma once
+
+#include <friction_msgs/InterfaceState.h>
+#include <friction_msgs/LatticeSnapshot.h>
+#include <friction_msgs/PrecursorPoint.h>
+#include <friction_msgs/SlipEvent.h>
+#include <friction_msgs/StageCommand.h>
+#include <friction_msgs/StageState.h>
+#include <friction_msgs/StrainGaugeProfile.h>
+#include <geometry_msgs/WrenchStamped.h>
+#include <ros/time.h>
+
+#include <string>
+
+#include "friction_sim/instruments.h"
+#include "friction_sim/loading_protocol.h"
+#include "friction_sim/slip_events.h"
+#include "friction_sim/stage.h"
+
+namespace friction {
+
+/// Simulated time (s) as a ROS stamp.
+ros::Time toStamp(double sim_time);
+
+/// Load cells as a force sensor reports them: F_X in force.x, F_Z in force.z (pressing down is +).
+geometry_msgs::WrenchStamped toMsg(const LoadCellReading& reading, const std::string& frame_id);
+LoadCellReading fromMsg(const geometry_msgs::WrenchStamped& msg);
+
+friction_msgs::InterfaceState toMsg(const InterfaceFrame& frame, std::uint32_t frame_index,
+                                    const std::string& frame_id);
+InterfaceFrame fromMsg(const friction_msgs::InterfaceState& msg);
+
+friction_msgs::StrainGaugeProfile toMsg(const GaugeProfile& profile, const std::string& frame_id);
+
+/// Wave speeds of the model, carried by every event so that v_c/c_R can be formed downstream.
+struct WaveSpeeds {
+  double rayleigh = 0.0;  ///< m/s
+  double shear = 0.0;     ///< m/s
+};
+friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>& positions, double slider_length,
+                               const WaveSpeeds& speeds, const std::string& frame_id);
+SlipEvent fromMsg(const friction_msgs::SlipEvent& msg);
+
+friction_msgs::PrecursorPoint toPointMsg(const SlipEvent& event, double slider_length, const std::string& frame_id);
+
+friction_msgs::LatticeSnapshot toMsg(const LatticeSnapshot& snapshot, const std::string& frame_id);
+
+/// Commands: the message's mode picks a stage command or a normal-load change; stamp = when.
+TimedCommand fromMsg(const friction_msgs::StageCommand& msg);
+friction_msgs::StageCommand toMsg(const TimedCommand& command);
+
+}  // namespace friction

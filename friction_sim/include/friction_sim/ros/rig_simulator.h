@@ -1,0 +1,131 @@
+// The rig simulator node: runs a scene and publishes what the lab's instruments measure.
+//
+// Parameters (private, ~):
+//   scene (string, required)        path of the scene YAML (the offline runner's format)
+//   overrides (string, "")          scene fields to replace, "key=value key=value" (e.g. "pusher.height=0.01")
+//   real_time_factor (double, 0)    simulated seconds per wall second; 0 runs as fast as possible
+//   load_cell_rate (double, 1e4)    Hz of simulated time, load_cells
+//   gauge_rate (double, 1e4)        Hz of simulated time, strain_gauges
+//   interface_rate (double, 1e5)    Hz of simulated time, interface frames during slip events
+//   interface_idle_rate (double, 100)  Hz of simulated time, interface frames while all is stuck
+//   stage_state_rate (double, 1e3)  Hz of simulated time, stage_state
+//   clock_rate (double, 1e4)        Hz of simulated time, /clock
+//   snapshot_rate (double, 20)      Hz of wall time, lattice snapshots for visualisation
+//   bag (string, "")                write every instrument topic to this bag, independent of subscribers
+//   frame_id (string, "slider")     frame of every message
+//   stop_at_scene_end (bool, true)  end when the scene's stop condition holds
+//
+// Published topics (relative to the node's namespace; stamps are simulated time):
+//   /clock (rosgraph_msgs/Clock)                   simulated time
+//   load_cells (geometry_msgs/WrenchStamped)       F_X in force.x, F_Z in force.z
+//   strain_gauges (friction_msgs/StrainGaugeProfile)
+//   interface (friction_msgs/InterfaceState)       also at every step where an event starts or ends
+//   slip_events (friction_msgs/SlipEvent)          when an event ends
+//   lattice (friction_msgs/LatticeSnapshot)
+//   stage_state (friction_msgs/StageState)
+// Subscribed topics:
+//   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time)
+// Services:
+//   send_command (friction_msgs/SendStageCommand)  the same, with the verdict in the reply
+//   pause (std_srvs/SetBool), reset (std_srvs/Trigger), stop (std_srvs/Trigger)
+//
+// Commands with NaN/inf, a normal load <= 0, a speed beyond the scene's stage.max_speed or an unknown
+// mode are refused with a logged reason; the simulation keeps running.
+#pragma once
+
+#include <friction_msgs/SendStageCommand.h>
+#include <friction_msgs/StageCommand.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <std_srvs/SetBool.h>
+#include <std_srvs/Trigger.h>
+
+#include <atomic>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "friction_sim/loading_protocol.h"
+#include "friction_sim/ros/conversions.h"
+#include "friction_sim/simulation.h"
+
+namespace friction {
+
+struct SimulatorOptions {
+  std::string scene_path;          ///< path of the scene YAML
+  std::string overrides;           ///< "key=value ..." scene fields to replace
+  double real_time_factor = 0.0;   ///< sim s per wall s; 0 = as fast as possible
+  double load_cell_rate = 1e4;     ///< Hz, simulated
+  double gauge_rate = 1e4;         ///< Hz, simulated
+  double interface_rate = 1e5;     ///< Hz, simulated, during events
+  double interface_idle_rate = 100.0;  ///< Hz, simulated, while all is stuck
+  double stage_state_rate = 1e3;   ///< Hz, simulated
+  double clock_rate = 1e4;         ///< Hz, simulated
+  double snapshot_rate = 20.0;     ///< Hz, wall
+  std::string bag_path;            ///< "" = no bag
+  std::string frame_id = "slider";
+  bool stop_at_scene_end = true;
+};
+
+/// Every problem of the options, each naming the parameter, the value and the allowed range.
+std::vector<std::string> validateOptions(const SimulatorOptions& options);
+/// Reads the options from the private parameters; throws ConfigError listing every problem.
+SimulatorOptions readSimulatorOptions(const ros::NodeHandle& private_nh);
+/// Splits "key=value key=value" into pairs; problems for malformed items.
+std::vector<std::pair<std::string, std::string>> parseOverrides(const std::string& text,
+                                                                std::vector<std::string>& problems);
+/// Why a command must be refused (empty = acceptable).
+std::string checkCommand(const friction_msgs::StageCommand& msg, const Stage& stage);
+
+/// Set by SIGINT/SIGTERM: the node finishes its bag and exits.
+extern std::atomic<bool> g_stop_requested;
+
+class RigSimulator {
+ public:
+  /// Loads the scene (throws SceneError/ConfigError before anything is advertised).
+  RigSimulator(ros::NodeHandle nh, SimulatorOptions options);
+  ~RigSimulator();
+  /// Runs until the scene ends, `stop` is called, the node is shut down or a signal arrives.
+  void run();
+
+ private:
+  void advertise();
+  void startSimulation();
+  void publishInstruments(bool event_boundary);
+  void publishClock();
+  void publishStageState();
+  void applyDueCommands();
+  std::string accept(const friction_msgs::StageCommand& msg);
+  void onCommand(const friction_msgs::StageCommand::ConstPtr& msg);
+  bool onSendCommand(friction_msgs::SendStageCommand::Request& request,
+                     friction_msgs::SendStageCommand::Response& response);
+  bool onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
+  bool onReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  bool onStop(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  void pace();
+  template <class Message>
+  void emit(ros::Publisher& publisher, const std::string& topic, const Message& msg);
+
+  ros::NodeHandle nh_;
+  SimulatorOptions options_;
+  Scene scene_;
+  std::unique_ptr<Simulation> simulation_;
+  std::vector<double> interface_positions_;
+  WaveSpeeds wave_speeds_;
+  std::multimap<double, TimedCommand> pending_;  ///< accepted commands by simulated time
+  rosbag::Bag bag_;
+  bool bag_open_ = false;
+  bool paused_ = false;
+  bool stop_ = false;
+  bool reset_requested_ = false;
+  std::uint32_t frame_index_ = 0;
+  double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0;
+  ros::WallTime next_snapshot_, pace_origin_wall_;
+  double pace_origin_sim_ = 0.0;
+  ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_;
+  ros::Subscriber command_sub_;
+  ros::ServiceServer command_srv_, pause_srv_, reset_srv_, stop_srv_;
+};
+
+}  // namespace friction

@@ -1,0 +1,41 @@
+// The loading-stage controller node: runs a loading protocol (friction_sim/loading_protocol.h) against
+// the simulator through its topics and services only, so a user can replace it with their own node.
+//
+// Parameters (private, ~):
+//   protocol (string, required)   path of the protocol YAML
+// Subscribed topics (relative to the node's namespace):
+//   stage_state (friction_msgs/StageState)  simulated time, F_Z, stage travel, global event count
+// Services called:
+//   send_command (friction_msgs/SendStageCommand)  every scheduled command, stamped with its time
+//   stop (std_srvs/Trigger)                        once an end condition of the protocol holds
+//
+// Uses ROS time only (the stage state's stamps, i.e. simulated time). If time jumps backwards (a reset
+// or looped playback), it starts the protocol again from the new time.
+#pragma once
+
+#include <friction_msgs/StageState.h>
+#include <ros/ros.h>
+
+#include "friction_sim/loading_protocol.h"
+
+namespace friction {
+
+class StageController {
+ public:
+  StageController(ros::NodeHandle nh, LoadingProtocol protocol);
+
+ private:
+  void onStageState(const friction_msgs::StageState::ConstPtr& msg);
+  void start(double time, double normal_force);
+
+  ros::NodeHandle nh_;
+  LoadingProtocol protocol_;
+  ros::Subscriber state_sub_;
+  ros::ServiceClient command_client_, stop_client_;
+  bool started_ = false;
+  bool ended_ = false;
+  double start_time_ = 0.0;
+  double last_time_ = 0.0;
+};
+
+}  // namespace friction

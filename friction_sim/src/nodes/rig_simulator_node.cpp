@@ -1,0 +1,20 @@
+// The rig simulator node; see friction_sim/ros/rig_simulator.h for its parameters, topics and services.
+#include <csignal>
+#include <iostream>
+
+#include "friction_sim/ros/rig_simulator.h"
+#include "friction_sim/yaml_fields.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "rig_simulator", ros::init_options::NoSigintHandler);
+  std::signal(SIGINT, [](int) { friction::g_stop_requested = true; });
+  std::signal(SIGTERM, [](int) { friction::g_stop_requested = true; });
+  try {
+    friction::RigSimulator simulator{ros::NodeHandle(), friction::readSimulatorOptions(ros::NodeHandle("~"))};
+    simulator.run();
+  } catch (const friction::ConfigError& error) {
+    std::cerr << error.what() << std::endl;
+    return 2;
+  }
+  return 0;
+}

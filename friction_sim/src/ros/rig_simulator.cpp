@@ -1,0 +1,318 @@
+#include "friction_sim/ros/rig_simulator.h"
+
+#include <rosgraph_msgs/Clock.h>
+
+#include <cmath>
+#include <iostream>
+#include <sstream>
+
+#include "friction_sim/results_io.h"
+#include "friction_sim/scene_io.h"
+
+namespace friction {
+
+std::atomic<bool> g_stop_requested{false};
+
+namespace {
+
+/// Rayleigh speed as a fraction of c_S for the lattice's ν = 1/3 (MODEL.md §2).
+constexpr double kRayleighFraction = 0.919;
+
+WaveSpeeds waveSpeedsOf(const Scene& scene) {
+  const double E = scene.material.youngs_modulus, rho = scene.material.density;
+  if (scene.model == ModelKind::Chain1D) return {0.0, std::sqrt(E / rho)};
+  const double shear = std::sqrt(3.0 * E / 8.0 / rho);
+  return {kRayleighFraction * shear, shear};
+}
+
+/// Advances a publication time past `now` on its regular grid; returns true if it was due.
+bool due(double now, double& next, double rate) {
+  if (now < next) return false;
+  const double period = 1.0 / rate;
+  next += period * (std::floor((now - next) / period) + 1.0);
+  return true;
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> parseOverrides(const std::string& text,
+                                                                std::vector<std::string>& problems) {
+  std::vector<std::pair<std::string, std::string>> overrides;
+  std::istringstream stream(text);
+  for (std::string item; stream >> item;) {
+    const auto equals = item.find('=');
+    if (equals == std::string::npos || equals == 0) {
+      problems.push_back("~overrides: item '" + item + "' is not allowed; allowed: key=value, e.g. pusher.height=0.01");
+      continue;
+    }
+    overrides.emplace_back(item.substr(0, equals), item.substr(equals + 1));
+  }
+  return overrides;
+}
+
+std::vector<std::string> validateOptions(const SimulatorOptions& o) {
+  std::vector<std::string> problems;
+  auto require = [&](bool ok, const std::string& name, double value, const std::string& allowed) {
+    if (ok) return;
+    std::ostringstream text;
+    text << "~" << name << ": value " << value << " is not allowed; allowed: " << allowed;
+    problems.push_back(text.str());
+  };
+  if (o.scene_path.empty()) problems.push_back("~scene: no value; allowed: the path of a scene YAML file");
+  require(std::isfinite(o.real_time_factor) && o.real_time_factor >= 0.0, "real_time_factor", o.real_time_factor,
+          ">= 0 (0 = as fast as possible)");
+  const std::pair<const char*, double> rates[] = {
+      {"load_cell_rate", o.load_cell_rate},   {"gauge_rate", o.gauge_rate},
+      {"interface_rate", o.interface_rate},   {"interface_idle_rate", o.interface_idle_rate},
+      {"stage_state_rate", o.stage_state_rate}, {"clock_rate", o.clock_rate},
+      {"snapshot_rate", o.snapshot_rate}};
+  for (const auto& [name, rate] : rates) require(std::isfinite(rate) && rate > 0.0, name, rate, "a rate > 0 Hz");
+  if (o.frame_id.empty()) problems.push_back("~frame_id: empty; allowed: a frame name such as 'slider'");
+  std::vector<std::string> override_problems;
+  parseOverrides(o.overrides, override_problems);
+  problems.insert(problems.end(), override_problems.begin(), override_problems.end());
+  return problems;
+}
+
+SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
+  SimulatorOptions o;
+  pnh.param("scene", o.scene_path, o.scene_path);
+  pnh.param("overrides", o.overrides, o.overrides);
+  pnh.param("real_time_factor", o.real_time_factor, o.real_time_factor);
+  pnh.param("load_cell_rate", o.load_cell_rate, o.load_cell_rate);
+  pnh.param("gauge_rate", o.gauge_rate, o.gauge_rate);
+  pnh.param("interface_rate", o.interface_rate, o.interface_rate);
+  pnh.param("interface_idle_rate", o.interface_idle_rate, o.interface_idle_rate);
+  pnh.param("stage_state_rate", o.stage_state_rate, o.stage_state_rate);
+  pnh.param("clock_rate", o.clock_rate, o.clock_rate);
+  pnh.param("snapshot_rate", o.snapshot_rate, o.snapshot_rate);
+  pnh.param("bag", o.bag_path, o.bag_path);
+  pnh.param("frame_id", o.frame_id, o.frame_id);
+  pnh.param("stop_at_scene_end", o.stop_at_scene_end, o.stop_at_scene_end);
+  const auto problems = validateOptions(o);
+  if (!problems.empty()) throw ConfigError("parameters of " + pnh.getNamespace(), problems);
+  return o;
+}
+
+std::string checkCommand(const friction_msgs::StageCommand& msg, const Stage& stage) {
+  std::ostringstream reason;
+  if (msg.mode > friction_msgs::StageCommand::NORMAL_LOAD) {
+    reason << "mode " << static_cast<int>(msg.mode) << " is unknown; allowed: 0 VELOCITY, 1 HOLD, 2 POSITION, 3 NORMAL_LOAD";
+  } else if (msg.mode == friction_msgs::StageCommand::NORMAL_LOAD) {
+    if (!std::isfinite(msg.normal_force) || msg.normal_force <= 0.0) {
+      reason << "normal load " << msg.normal_force << " N is not allowed; allowed: a finite F_Z > 0 N";
+    }
+  } else if (msg.mode != friction_msgs::StageCommand::HOLD) {
+    return stage.checkCommand(fromMsg(msg).stage);
+  }
+  return reason.str();
+}
+
+RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
+    : nh_(std::move(nh)), options_(std::move(options)) {
+  std::vector<std::string> problems;
+  const auto overrides = parseOverrides(options_.overrides, problems);
+  scene_ = loadScene(options_.scene_path);
+  if (!overrides.empty()) scene_ = overrideScene(scene_, overrides);
+  wave_speeds_ = waveSpeedsOf(scene_);
+  startSimulation();
+  if (!options_.bag_path.empty()) {
+    bag_.open(options_.bag_path, rosbag::bagmode::Write);
+    bag_open_ = true;
+  }
+  advertise();
+}
+
+RigSimulator::~RigSimulator() {
+  if (bag_open_) bag_.close();
+}
+
+void RigSimulator::startSimulation() {
+  simulation_ = std::make_unique<Simulation>(scene_);
+  interface_positions_.clear();
+  for (int node = 0; node < simulation_->model().interfaceNodeCount(); ++node) {
+    interface_positions_.push_back(simulation_->model().interfacePosition(node));
+  }
+  pending_.clear();
+  next_load_cells_ = next_gauges_ = next_frame_ = next_stage_state_ = next_clock_ = 0.0;
+  next_snapshot_ = ros::WallTime::now();
+  pace_origin_wall_ = ros::WallTime::now();
+  pace_origin_sim_ = 0.0;
+  reset_requested_ = false;
+}
+
+void RigSimulator::advertise() {
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 100);
+  load_cells_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("load_cells", 1000);
+  gauges_pub_ = nh_.advertise<friction_msgs::StrainGaugeProfile>("strain_gauges", 1000);
+  interface_pub_ = nh_.advertise<friction_msgs::InterfaceState>("interface", 10000);
+  events_pub_ = nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
+  lattice_pub_ = nh_.advertise<friction_msgs::LatticeSnapshot>("lattice", 2);
+  stage_pub_ = nh_.advertise<friction_msgs::StageState>("stage_state", 100);
+  command_sub_ = nh_.subscribe("stage_command", 1000, &RigSimulator::onCommand, this);
+  command_srv_ = nh_.advertiseService("send_command", &RigSimulator::onSendCommand, this);
+  pause_srv_ = nh_.advertiseService("pause", &RigSimulator::onPause, this);
+  reset_srv_ = nh_.advertiseService("reset", &RigSimulator::onReset, this);
+  stop_srv_ = nh_.advertiseService("stop", &RigSimulator::onStop, this);
+}
+
+template <class Message>
+void RigSimulator::emit(ros::Publisher& publisher, const std::string& topic, const Message& msg) {
+  publisher.publish(msg);
+  if (bag_open_) bag_.write(publisher.getTopic().empty() ? topic : publisher.getTopic(), msg.header.stamp, msg);
+}
+
+void RigSimulator::publishClock() {
+  rosgraph_msgs::Clock clock;
+  clock.clock = toStamp(simulation_->time());
+  clock_pub_.publish(clock);
+}
+
+void RigSimulator::publishStageState() {
+  const Stage& stage = simulation_->stage();
+  const LoadCellReading cells = simulation_->loadCells();
+  friction_msgs::StageState msg;
+  msg.header.stamp = toStamp(simulation_->time());
+  msg.header.frame_id = options_.frame_id;
+  msg.mode = static_cast<std::uint8_t>(stage.current().mode);
+  msg.position = stage.position();
+  msg.velocity = stage.velocity();
+  msg.target = stage.current().target;
+  msg.travel = stage.travel();
+  msg.shear_force = cells.shear_force;
+  msg.normal_force = cells.normal_force;
+  msg.global_events = simulation_->globalEventCount();
+  msg.paused = paused_;
+  emit(stage_pub_, "stage_state", msg);
+}
+
+void RigSimulator::publishInstruments(bool event_boundary) {
+  const double t = simulation_->time();
+  const std::string& frame = options_.frame_id;
+  if (due(t, next_clock_, options_.clock_rate)) publishClock();
+  if (due(t, next_load_cells_, options_.load_cell_rate) || event_boundary) {
+    emit(load_cells_pub_, "load_cells", toMsg(simulation_->loadCells(), frame));
+  }
+  if (due(t, next_gauges_, options_.gauge_rate) && scene_.model == ModelKind::Lattice2D) {
+    emit(gauges_pub_, "strain_gauges", toMsg(simulation_->gaugeProfile(), frame));
+  }
+  const double frame_rate = simulation_->inEvent() ? options_.interface_rate : options_.interface_idle_rate;
+  if (event_boundary || t >= next_frame_) {
+    emit(interface_pub_, "interface", toMsg(simulation_->interfaceFrame(), frame_index_++, frame));
+    next_frame_ = t + 1.0 / frame_rate;
+  }
+  if (simulation_->eventEndedLastStep()) {
+    emit(events_pub_, "slip_events",
+         toMsg(simulation_->events().back(), interface_positions_, scene_.geometry.length, wave_speeds_, frame));
+  }
+  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState();
+  if (ros::WallTime::now() >= next_snapshot_ && lattice_pub_.getNumSubscribers() > 0) {
+    lattice_pub_.publish(toMsg(simulation_->snapshot(), frame));
+    next_snapshot_ = ros::WallTime::now() + ros::WallDuration(1.0 / options_.snapshot_rate);
+  }
+}
+
+std::string RigSimulator::accept(const friction_msgs::StageCommand& msg) {
+  std::string reason = checkCommand(msg, simulation_->stage());
+  if (!reason.empty()) {
+    ROS_WARN_STREAM("stage command refused: " << reason);
+    return reason;
+  }
+  const TimedCommand command = fromMsg(msg);
+  pending_.emplace(command.time, command);
+  return {};
+}
+
+void RigSimulator::applyDueCommands() {
+  const double now = simulation_->time();
+  while (!pending_.empty() && pending_.begin()->first <= now) {
+    const TimedCommand& command = pending_.begin()->second;
+    if (command.time < now - simulation_->timeStep()) {
+      ROS_DEBUG_STREAM("command for t = " << command.time << " s applied late, at " << now << " s");
+    }
+    const std::string reason = command.kind == TimedCommand::Kind::NormalLoad
+                                   ? simulation_->setNormalLoad(command.normal_force)
+                                   : simulation_->stage().command(command.stage);
+    if (!reason.empty()) ROS_WARN_STREAM("stage command refused: " << reason);
+    pending_.erase(pending_.begin());
+  }
+}
+
+void RigSimulator::onCommand(const friction_msgs::StageCommand::ConstPtr& msg) { accept(*msg); }
+
+bool RigSimulator::onSendCommand(friction_msgs::SendStageCommand::Request& request,
+                                 friction_msgs::SendStageCommand::Response& response) {
+  response.reason = accept(request.command);
+  response.accepted = response.reason.empty();
+  return true;
+}
+
+bool RigSimulator::onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
+  paused_ = request.data;
+  response.success = true;
+  response.message = paused_ ? "paused" : "running";
+  if (!paused_) {
+    pace_origin_wall_ = ros::WallTime::now();
+    pace_origin_sim_ = simulation_->time();
+  }
+  return true;
+}
+
+bool RigSimulator::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  reset_requested_ = true;
+  response.success = true;
+  response.message = "restarting the scene from its loaded equilibrium";
+  return true;
+}
+
+bool RigSimulator::onStop(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  stop_ = true;
+  response.success = true;
+  response.message = "stopping at t = " + std::to_string(simulation_->time()) + " s";
+  return true;
+}
+
+void RigSimulator::pace() {
+  if (options_.real_time_factor <= 0.0) return;
+  const double ahead = (simulation_->time() - pace_origin_sim_) / options_.real_time_factor -
+                       (ros::WallTime::now() - pace_origin_wall_).toSec();
+  if (ahead > 1e-3) ros::WallDuration(ahead).sleep();
+}
+
+void RigSimulator::run() {
+  const auto start = ros::WallTime::now();
+  ros::WallTime next_spin = start;
+  while (!stop_ && !g_stop_requested && ros::ok()) {
+    const ros::WallTime now = ros::WallTime::now();
+    if (now >= next_spin || paused_) {
+      ros::spinOnce();
+      next_spin = now + ros::WallDuration(0.002);
+    }
+    if (reset_requested_) {
+      startSimulation();
+      continue;
+    }
+    if (paused_) {
+      publishStageState();
+      ros::WallDuration(0.01).sleep();
+      continue;
+    }
+    applyDueCommands();
+    simulation_->step();
+    publishInstruments(simulation_->eventStartedLastStep() || simulation_->eventEndedLastStep());
+    if (options_.stop_at_scene_end && simulation_->finished()) {
+      ROS_INFO_STREAM("scene ended: " << simulation_->stopReason());
+      break;
+    }
+    pace();
+  }
+  publishStageState();
+  printSummary(std::cout, summarize(*simulation_, (ros::WallTime::now() - start).toSec()));
+  if (bag_open_) {
+    bag_.close();
+    bag_open_ = false;
+    std::cout << "  bag written to " << options_.bag_path << std::endl;
+  }
+}
+
+}  // namespace friction

@@ -1,0 +1,52 @@
+#include "friction_sim/ros/stage_controller.h"
+
+#include <friction_msgs/SendStageCommand.h>
+#include <std_srvs/Trigger.h>
+
+#include "friction_sim/ros/conversions.h"
+
+namespace friction {
+
+StageController::StageController(ros::NodeHandle nh, LoadingProtocol protocol)
+    : nh_(std::move(nh)), protocol_(std::move(protocol)) {
+  command_client_ = nh_.serviceClient<friction_msgs::SendStageCommand>("send_command");
+  stop_client_ = nh_.serviceClient<std_srvs::Trigger>("stop");
+  state_sub_ = nh_.subscribe("stage_state", 100, &StageController::onStageState, this);
+}
+
+void StageController::start(double time, double normal_force) {
+  started_ = true;
+  ended_ = false;
+  start_time_ = time;
+  command_client_.waitForExistence();
+  for (const TimedCommand& command : scheduleProtocol(protocol_, time, normal_force)) {
+    friction_msgs::SendStageCommand call;
+    call.request.command = toMsg(command);
+    if (!command_client_.call(call)) {
+      ROS_ERROR("stage controller: send_command failed (is the simulator running?)");
+    } else if (!call.response.accepted) {
+      ROS_ERROR_STREAM("stage controller: command for t = " << command.time << " s refused: " << call.response.reason);
+    }
+  }
+  ROS_INFO_STREAM("stage controller: protocol started at t = " << time << " s");
+}
+
+void StageController::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
+  const double time = msg->header.stamp.toSec();
+  if (started_ && time < last_time_) {
+    ROS_WARN_STREAM("stage controller: time jumped back from " << last_time_ << " s to " << time
+                                                              << " s; restarting the protocol");
+    started_ = false;
+  }
+  last_time_ = time;
+  if (!started_) start(time, msg->normal_force);
+  if (ended_ || !protocolEnded(protocol_.end, msg->global_events, msg->travel, time - start_time_)) return;
+  ended_ = true;
+  ROS_INFO_STREAM("stage controller: protocol ended at t = " << time << " s after " << msg->global_events
+                                                             << " global events; stopping the simulator");
+  std_srvs::Trigger stop;
+  stop_client_.call(stop);
+  ros::shutdown();
+}
+
+}  // namespace friction
