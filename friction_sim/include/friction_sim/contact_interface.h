@@ -49,6 +49,8 @@ class ContactInterface {
   double frictionForce(int node) const { return friction_[node]; }  ///< N, track on slider, x
   double normalForce(int node) const { return normal_[node]; }      ///< N
   double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m
+  /// m, the node's x displacement at the start of the last step (before any unstick catch-up).
+  double stepStartPosition(int node) const { return start_u_[node]; }
   /// Nodes that unstuck (or slid off on returning contact) at the end of the last step.
   const std::vector<int>& unstuckLastStep() const { return unstuck_last_step_; }
   /// Nodes that re-stuck during the last step.

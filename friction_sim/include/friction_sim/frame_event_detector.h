@@ -6,6 +6,7 @@
 #pragma once
 
 #include <deque>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -16,8 +17,8 @@ namespace friction {
 
 class FrameEventDetector {
  public:
-  /// `slider_length` (m) for L_p/L; `front_fit_nodes` as in the scene.
-  FrameEventDetector(double slider_length, int front_fit_nodes);
+  /// `front_fit_nodes` as in the scene.
+  explicit FrameEventDetector(int front_fit_nodes);
 
   /// Load-cell samples, in time order.
   void addLoadCells(const LoadCellReading& reading);
@@ -29,11 +30,14 @@ class FrameEventDetector {
   /// Forgets everything (time jumped backwards, e.g. looped playback).
   void reset();
 
+  /// m, the slider's length L as the frames show it (the last interface node sits at x = L); 0 before
+  /// the first frame.
   double sliderLength() const { return slider_length_; }
 
  private:
-  double slider_length_;
   int front_fit_nodes_;
+  double slider_length_ = 0.0;
+  double last_frame_time_ = -std::numeric_limits<double>::infinity();
   int next_index_ = 0;
   std::deque<LoadCellReading> load_cells_;
   std::optional<InterfaceFrame> last_stuck_frame_;

@@ -13,8 +13,7 @@ bool anySliding(const InterfaceFrame& frame) {
 }
 }  // namespace
 
-FrameEventDetector::FrameEventDetector(double slider_length, int front_fit_nodes)
-    : slider_length_(slider_length), front_fit_nodes_(front_fit_nodes) {}
+FrameEventDetector::FrameEventDetector(int front_fit_nodes) : front_fit_nodes_(front_fit_nodes) {}
 
 void FrameEventDetector::reset() {
   next_index_ = 0;
@@ -22,6 +21,7 @@ void FrameEventDetector::reset() {
   last_stuck_frame_.reset();
   in_event_ = false;
   ended_.clear();
+  last_frame_time_ = -std::numeric_limits<double>::infinity();
 }
 
 void FrameEventDetector::addLoadCells(const LoadCellReading& reading) {
@@ -46,7 +46,8 @@ std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents() {
   }
   // Keep the samples from the last one before any onset still to be resolved: those of ended and
   // current events, and of an event starting after the last all-stuck frame.
-  double horizon = latest;
+  // The topics travel separately: load cells may run ahead of the frames, so never beyond the last frame.
+  double horizon = std::min(latest, last_frame_time_);
   if (last_stuck_frame_) horizon = std::min(horizon, last_stuck_frame_->time);
   if (in_event_) horizon = std::min(horizon, current_.onset_time);
   if (!ended_.empty()) horizon = std::min(horizon, ended_.front().onset_time);
@@ -56,6 +57,8 @@ std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents() {
 
 void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   const std::size_t n = frame.position.size();
+  last_frame_time_ = frame.time;
+  if (n > 0) slider_length_ = frame.position.back();
   const bool sliding = anySliding(frame);
   if (!in_event_) {
     if (!sliding || !last_stuck_frame_ || last_stuck_frame_->position.size() != n) {

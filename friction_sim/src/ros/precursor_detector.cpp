@@ -6,11 +6,13 @@ namespace friction {
 
 PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(std::move(nh)), private_nh_(std::move(private_nh)) {
-  private_nh_.param("front_fit_nodes", front_fit_nodes_, 5);
-  if (front_fit_nodes_ < 2) {
-    ROS_WARN_STREAM("~front_fit_nodes: value " << front_fit_nodes_ << " is not allowed; allowed: >= 2; using 5");
-    front_fit_nodes_ = 5;
+  int front_fit_nodes = 5;
+  private_nh_.param("front_fit_nodes", front_fit_nodes, front_fit_nodes);
+  if (front_fit_nodes < 2) {
+    ROS_WARN_STREAM("~front_fit_nodes: value " << front_fit_nodes << " is not allowed; allowed: >= 2; using 5");
+    front_fit_nodes = 5;
   }
+  detector_ = std::make_unique<FrameEventDetector>(front_fit_nodes);
   events_pub_ = private_nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   points_pub_ = private_nh_.advertise<friction_msgs::PrecursorPoint>("precursor_points", 1000, true);
   // Deep queues: a bag played fast must not drop frames, or events would be merged.
@@ -20,26 +22,22 @@ PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private
 }
 
 void PrecursorDetector::checkTime(const ros::Time& stamp) {
-  if (!last_stamp_.isZero() && stamp < last_stamp_ - ros::Duration(1e-3) && detector_) {
+  // Seconds, not ros::Time: near t = 0 the margin would underflow ros::Time's unsigned range.
+  if (stamp.toSec() < last_stamp_.toSec() - 1e-3) {
     ROS_WARN_STREAM("precursor detector: time jumped back to " << stamp.toSec() << " s; starting over");
-    detector_.reset();
+    detector_->reset();
   }
   last_stamp_ = stamp;
 }
 
 void PrecursorDetector::onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
-  if (!detector_) return;
   detector_->addLoadCells(fromMsg(*msg));
   publishCompleted();
 }
 
 void PrecursorDetector::onFrame(const friction_msgs::InterfaceState::ConstPtr& msg) {
   checkTime(msg->header.stamp);
-  if (!detector_) {
-    // The slider's length is the last interface node's position: nodes run from 0 to L.
-    detector_ = std::make_unique<FrameEventDetector>(msg->position.back(), front_fit_nodes_);
-    positions_ = msg->position;
-  }
+  positions_ = msg->position;
   detector_->addFrame(fromMsg(*msg));
   publishCompleted();
 }

@@ -89,6 +89,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   pnh.param("bag", o.bag_path, o.bag_path);
   pnh.param("frame_id", o.frame_id, o.frame_id);
   pnh.param("stop_at_scene_end", o.stop_at_scene_end, o.stop_at_scene_end);
+  pnh.param("start_paused", o.start_paused, o.start_paused);
   const auto problems = validateOptions(o);
   if (!problems.empty()) throw ConfigError("parameters of " + pnh.getNamespace(), problems);
   return o;
@@ -115,6 +116,7 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
   scene_ = loadScene(options_.scene_path);
   if (!overrides.empty()) scene_ = overrideScene(scene_, overrides);
   wave_speeds_ = waveSpeedsOf(scene_);
+  paused_ = options_.start_paused;
   startSimulation();
   if (!options_.bag_path.empty()) {
     bag_.open(options_.bag_path, rosbag::bagmode::Write);
@@ -159,7 +161,9 @@ void RigSimulator::advertise() {
 template <class Message>
 void RigSimulator::emit(ros::Publisher& publisher, const std::string& topic, const Message& msg) {
   publisher.publish(msg);
-  if (bag_open_) bag_.write(publisher.getTopic().empty() ? topic : publisher.getTopic(), msg.header.stamp, msg);
+  // Before the first step (t = 0, e.g. the stage state while waiting paused) nothing was measured, and
+  // a bag cannot hold a zero stamp.
+  if (bag_open_ && !msg.header.stamp.isZero()) bag_.write(publisher.getTopic().empty() ? topic : publisher.getTopic(), msg.header.stamp, msg);
 }
 
 void RigSimulator::publishClock() {
@@ -293,7 +297,7 @@ void RigSimulator::run() {
       continue;
     }
     if (paused_) {
-      publishStageState();
+      publishStageState();  // so that a controller learns the time and F_Z while the rig waits
       ros::WallDuration(0.01).sleep();
       continue;
     }

@@ -1,15 +1,17 @@
 #include "friction_sim/ros/stage_controller.h"
 
 #include <friction_msgs/SendStageCommand.h>
+#include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 
 #include "friction_sim/ros/conversions.h"
 
 namespace friction {
 
-StageController::StageController(ros::NodeHandle nh, LoadingProtocol protocol)
-    : nh_(std::move(nh)), protocol_(std::move(protocol)) {
+StageController::StageController(ros::NodeHandle nh, LoadingProtocol protocol, double start_delay)
+    : nh_(std::move(nh)), protocol_(std::move(protocol)), start_delay_(start_delay) {
   command_client_ = nh_.serviceClient<friction_msgs::SendStageCommand>("send_command");
+  pause_client_ = nh_.serviceClient<std_srvs::SetBool>("pause");
   stop_client_ = nh_.serviceClient<std_srvs::Trigger>("stop");
   state_sub_ = nh_.subscribe("stage_state", 100, &StageController::onStageState, this);
 }
@@ -28,6 +30,10 @@ void StageController::start(double time, double normal_force) {
       ROS_ERROR_STREAM("stage controller: command for t = " << command.time << " s refused: " << call.response.reason);
     }
   }
+  ros::WallDuration(start_delay_).sleep();
+  std_srvs::SetBool run;
+  run.request.data = false;
+  pause_client_.call(run);
   ROS_INFO_STREAM("stage controller: protocol started at t = " << time << " s");
 }
 

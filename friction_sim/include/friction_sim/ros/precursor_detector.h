@@ -34,7 +34,6 @@ class PrecursorDetector {
   void publishCompleted();
 
   ros::NodeHandle nh_, private_nh_;
-  int front_fit_nodes_;
   std::unique_ptr<FrameEventDetector> detector_;
   std::vector<double> positions_;
   ros::Time last_stamp_;

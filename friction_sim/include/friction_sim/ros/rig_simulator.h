@@ -14,6 +14,8 @@
 //   bag (string, "")                write every instrument topic to this bag, independent of subscribers
 //   frame_id (string, "slider")     frame of every message
 //   stop_at_scene_end (bool, true)  end when the scene's stop condition holds
+//   start_paused (bool, false)      wait at t = 0 until `pause` is called with false (a controller
+//                                   sends its schedule first, so every command is on time)
 //
 // Published topics (relative to the node's namespace; stamps are simulated time):
 //   /clock (rosgraph_msgs/Clock)                   simulated time
@@ -66,6 +68,7 @@ struct SimulatorOptions {
   std::string bag_path;            ///< "" = no bag
   std::string frame_id = "slider";
   bool stop_at_scene_end = true;
+  bool start_paused = false;
 };
 
 /// Every problem of the options, each naming the parameter, the value and the allowed range.

@@ -3,10 +3,14 @@
 //
 // Parameters (private, ~):
 //   protocol (string, required)   path of the protocol YAML
+//   start_delay (double, 1.0)     wall seconds to wait before starting a simulator that waits paused,
+//                                 so that analysis nodes and recorders are connected from the first step
 // Subscribed topics (relative to the node's namespace):
 //   stage_state (friction_msgs/StageState)  simulated time, F_Z, stage travel, global event count
 // Services called:
 //   send_command (friction_msgs/SendStageCommand)  every scheduled command, stamped with its time
+//   pause (std_srvs/SetBool)                        called with false once the schedule is sent, so
+//                                                   that a simulator started paused runs every command on time
 //   stop (std_srvs/Trigger)                        once an end condition of the protocol holds
 //
 // Uses ROS time only (the stage state's stamps, i.e. simulated time). If time jumps backwards (a reset
@@ -22,7 +26,7 @@ namespace friction {
 
 class StageController {
  public:
-  StageController(ros::NodeHandle nh, LoadingProtocol protocol);
+  StageController(ros::NodeHandle nh, LoadingProtocol protocol, double start_delay);
 
  private:
   void onStageState(const friction_msgs::StageState::ConstPtr& msg);
@@ -30,8 +34,9 @@ class StageController {
 
   ros::NodeHandle nh_;
   LoadingProtocol protocol_;
+  double start_delay_;
   ros::Subscriber state_sub_;
-  ros::ServiceClient command_client_, stop_client_;
+  ros::ServiceClient command_client_, pause_client_, stop_client_;
   bool started_ = false;
   bool ended_ = false;
   double start_time_ = 0.0;

@@ -1,0 +1,276 @@
+// rostest node for whole runs through rig.launch. It watches a run, then asserts on what it saw and on
+// the bag the simulator wrote.
+//   mode "full": topics and types, stamps in simulated time, /clock monotonic, bad commands and bad
+//     parameters refused while the rig keeps running, the bag holds every slip event with no gap in
+//     the interface frames, the live and the replayed precursor detector agree with the simulator,
+//     and the live run equals an offline run of the same scene and commands.
+//   mode "kill": the simulator killed mid-run leaves a readable bag with everything up to the kill.
+#include <friction_msgs/InterfaceState.h>
+#include <friction_msgs/PrecursorPoint.h>
+#include <friction_msgs/SendStageCommand.h>
+#include <friction_msgs/SlipEvent.h>
+#include <friction_msgs/StageState.h>
+#include <friction_msgs/StrainGaugeProfile.h>
+#include <geometry_msgs/WrenchStamped.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <rosgraph_msgs/Clock.h>
+
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "friction_sim/loading_protocol.h"
+#include "friction_sim/ros/conversions.h"
+#include "friction_sim/scene_io.h"
+#include "friction_sim/simulation.h"
+
+namespace friction {
+namespace {
+
+/// What a run showed on its topics.
+struct Observed {
+  std::vector<friction_msgs::SlipEvent> events;
+  std::vector<friction_msgs::PrecursorPoint> live_points, replay_points;
+  std::vector<double> clock, load_cell_stamps;
+  int gauge_profiles = 0;
+  double last_stage_time = 0.0;
+  int stage_states = 0;
+  std::map<std::string, std::string> topic_types;
+  std::vector<friction_msgs::SendStageCommand::Response> bad_command_replies;
+  double time_after_bad_commands = 0.0;
+  std::string bad_scene_output, bad_parameter_output;
+  int bad_scene_status = 0, bad_parameter_status = 0;
+};
+Observed g_seen;
+std::string g_bag;
+
+/// Runs a command, returning its exit status and output.
+int runCommand(const std::string& command, std::string& output) {
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  char buffer[512];
+  while (fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  const int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool waitFor(const std::function<bool()>& condition, double seconds) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    if (condition()) return true;
+    ros::WallDuration(0.01).sleep();
+  }
+  return condition();
+}
+
+template <class Message, class Callback>
+ros::Subscriber listen(ros::NodeHandle& nh, const std::string& topic, Callback callback) {
+  return nh.subscribe<Message>(topic, 10000, boost::function<void(const typename Message::ConstPtr&)>(callback));
+}
+
+bool bagReadable(const std::string& path) {
+  try {
+    rosbag::Bag bag(path, rosbag::bagmode::Read);
+    return true;
+  } catch (const rosbag::BagException&) {
+    return false;
+  }
+}
+
+template <class Message>
+std::vector<typename Message::ConstPtr> readTopic(const std::string& path, const std::string& topic) {
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  std::vector<typename Message::ConstPtr> out;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(topic))) {
+    if (auto msg = m.instantiate<Message>()) out.push_back(msg);
+  }
+  return out;
+}
+
+void checkBagHasEveryEventAndNoFrameGap(const std::vector<friction_msgs::SlipEvent>& live) {
+  ASSERT_TRUE(bagReadable(g_bag)) << g_bag;
+  const auto events = readTopic<friction_msgs::SlipEvent>(g_bag, "/rig/slip_events");
+  ASSERT_GE(events.size(), live.size());
+  for (std::size_t e = 0; e < live.size(); ++e) {
+    EXPECT_EQ(events[e]->index, live[e].index);
+    EXPECT_EQ(events[e]->onset_time, live[e].onset_time);
+    EXPECT_EQ(events[e]->rupture_length, live[e].rupture_length);
+    EXPECT_EQ(events[e]->node_slip, live[e].node_slip);
+  }
+  const auto frames = readTopic<friction_msgs::InterfaceState>(g_bag, "/rig/interface");
+  ASSERT_FALSE(frames.empty());
+  for (std::size_t f = 0; f < frames.size(); ++f) ASSERT_EQ(frames[f]->frame_index, f) << "gap before frame " << f;
+}
+
+TEST(FullRun, TopicsHaveTheirTypesAndSimulatedTimeStamps) {
+  EXPECT_EQ(g_seen.topic_types["/rig/load_cells"], "geometry_msgs/WrenchStamped");
+  EXPECT_EQ(g_seen.topic_types["/rig/interface"], "friction_msgs/InterfaceState");
+  EXPECT_EQ(g_seen.topic_types["/rig/strain_gauges"], "friction_msgs/StrainGaugeProfile");
+  EXPECT_EQ(g_seen.topic_types["/rig/slip_events"], "friction_msgs/SlipEvent");
+  EXPECT_EQ(g_seen.topic_types["/rig/stage_state"], "friction_msgs/StageState");
+  EXPECT_EQ(g_seen.topic_types["/rig/lattice"], "friction_msgs/LatticeSnapshot");
+  EXPECT_EQ(g_seen.topic_types["/clock"], "rosgraph_msgs/Clock");
+  ASSERT_GT(g_seen.clock.size(), 10u);
+  for (std::size_t i = 1; i < g_seen.clock.size(); ++i) ASSERT_GE(g_seen.clock[i], g_seen.clock[i - 1]);
+  // Load cells at 10 kHz of simulated time (plus one sample at each event's start and end).
+  const auto cells = readTopic<geometry_msgs::WrenchStamped>(g_bag, "/rig/load_cells");
+  ASSERT_GT(cells.size(), 100u);
+  const double span = cells.back()->header.stamp.toSec() - cells.front()->header.stamp.toSec();
+  const double extra = 2.0 * g_seen.events.size();
+  EXPECT_NEAR(cells.size() - extra, span * 1e4, 0.01 * span * 1e4 + 2);
+  for (std::size_t i = 1; i < cells.size(); ++i) ASSERT_GE(cells[i]->header.stamp, cells[i - 1]->header.stamp);
+  EXPECT_GT(g_seen.gauge_profiles, 0);
+  EXPECT_GT(g_seen.stage_states, 0);
+}
+
+TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
+  ASSERT_EQ(g_seen.bad_command_replies.size(), 3u);
+  for (const auto& reply : g_seen.bad_command_replies) {
+    EXPECT_FALSE(reply.accepted);
+    EXPECT_FALSE(reply.reason.empty());
+  }
+  EXPECT_NE(g_seen.bad_command_replies[0].reason.find("finite"), std::string::npos);
+  EXPECT_NE(g_seen.bad_command_replies[1].reason.find("normal load -5 N"), std::string::npos);
+  EXPECT_NE(g_seen.bad_command_replies[2].reason.find("max_speed"), std::string::npos);
+  EXPECT_GT(g_seen.last_stage_time, g_seen.time_after_bad_commands);
+  EXPECT_EQ(g_seen.bad_scene_status, 2);
+  EXPECT_NE(g_seen.bad_scene_output.find("scene refused"), std::string::npos) << g_seen.bad_scene_output;
+  EXPECT_NE(g_seen.bad_scene_output.find("friction.kinetic_coefficient: value 0.9"), std::string::npos);
+  EXPECT_NE(g_seen.bad_scene_output.find("pusher.height: value 1"), std::string::npos);
+  EXPECT_EQ(g_seen.bad_parameter_status, 2);
+  EXPECT_NE(g_seen.bad_parameter_output.find("~load_cell_rate: value -1"), std::string::npos)
+      << g_seen.bad_parameter_output;
+}
+
+TEST(FullRun, BagHoldsEverySlipEventAndEveryInterfaceFrame) {
+  ASSERT_GE(g_seen.events.size(), 2u);
+  checkBagHasEveryEventAndNoFrameGap(g_seen.events);
+}
+
+void expectPointsMatchEvents(const std::vector<friction_msgs::PrecursorPoint>& points) {
+  ASSERT_EQ(points.size(), g_seen.events.size());
+  for (std::size_t e = 0; e < points.size(); ++e) {
+    const auto& event = g_seen.events[e];
+    EXPECT_EQ(points[e].global_event, event.global_event);
+    EXPECT_DOUBLE_EQ(points[e].length_ratio, event.rupture_length / event.slider_length);
+    // The detector reads F_X at the end of the onset step, the simulator within it: they differ by
+    // at most one step of loading, K·V·dt/F_Z = 3.3e-6 in this scene.
+    EXPECT_NEAR(points[e].shear_ratio, event.onset_shear_force / event.onset_normal_force, 1e-5);
+  }
+}
+
+TEST(FullRun, LivePrecursorDetectorAgreesWithTheSimulator) { expectPointsMatchEvents(g_seen.live_points); }
+
+TEST(FullRun, ReplayedBagGivesTheSamePrecursorPoints) { expectPointsMatchEvents(g_seen.replay_points); }
+
+TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
+  ros::NodeHandle pnh("~");
+  std::string scene_path, protocol_path;
+  pnh.getParam("scene", scene_path);
+  pnh.getParam("protocol", protocol_path);
+  Simulation offline(loadScene(scene_path));
+  const auto schedule = scheduleProtocol(loadProtocol(protocol_path), 0.0, offline.scene().load.normal_force);
+  std::size_t next = 0;
+  while (offline.globalEventCount() < 2 && offline.time() < 5.0) {
+    // As the simulator node does: commands due by now are applied before the step.
+    for (; next < schedule.size() && schedule[next].time <= offline.time(); ++next) {
+      offline.stage().command(schedule[next].stage);
+    }
+    offline.step();
+  }
+  ASSERT_EQ(offline.events().size(), g_seen.events.size());
+  for (std::size_t e = 0; e < g_seen.events.size(); ++e) {
+    EXPECT_EQ(offline.events()[e].onset_time, g_seen.events[e].onset_time);
+    EXPECT_EQ(offline.events()[e].onset_shear_force, g_seen.events[e].onset_shear_force);
+    EXPECT_EQ(offline.events()[e].node_slip, g_seen.events[e].node_slip);
+  }
+}
+
+TEST(KillRun, BagIsReadableAndHoldsEverythingUpToTheKill) {
+  ASSERT_GE(g_seen.events.size(), 2u);
+  checkBagHasEveryEventAndNoFrameGap(g_seen.events);
+}
+
+void watchFullRun(ros::NodeHandle& nh) {
+  auto rig = std::make_shared<ros::NodeHandle>("/rig");
+  std::vector<ros::Subscriber> subs;
+  subs.push_back(listen<friction_msgs::SlipEvent>(nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); }));
+  subs.push_back(listen<friction_msgs::PrecursorPoint>(nh, "/rig/precursor_detector/precursor_points", [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.live_points.push_back(*m); }));
+  subs.push_back(listen<friction_msgs::PrecursorPoint>(nh, "/replay/precursor_detector/precursor_points", [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.replay_points.push_back(*m); }));
+  subs.push_back(listen<rosgraph_msgs::Clock>(nh, "/clock", [](const rosgraph_msgs::Clock::ConstPtr& m) { g_seen.clock.push_back(m->clock.toSec()); }));
+  subs.push_back(listen<friction_msgs::StrainGaugeProfile>(nh, "/rig/strain_gauges", [](const friction_msgs::StrainGaugeProfile::ConstPtr&) { ++g_seen.gauge_profiles; }));
+  subs.push_back(listen<friction_msgs::StageState>(nh, "/rig/stage_state", [](const friction_msgs::StageState::ConstPtr& m) {
+                                                           ++g_seen.stage_states;
+                                                           g_seen.last_stage_time = m->header.stamp.toSec();
+                                                         }));
+  subs.push_back(listen<friction_msgs::LatticeSnapshot>(nh, "/rig/lattice", [](const friction_msgs::LatticeSnapshot::ConstPtr&) {}));
+  // While the rig runs: bad commands, then a bad scene and a bad parameter for a second simulator.
+  waitFor([] { return g_seen.last_stage_time > 1e-3; }, 60.0);
+  ros::ServiceClient client = nh.serviceClient<friction_msgs::SendStageCommand>("/rig/send_command");
+  for (auto [mode, speed, load] : {std::tuple<int, double, double>{0, std::nan(""), 0.0},
+                                   std::tuple<int, double, double>{3, 0.0, -5.0},
+                                   std::tuple<int, double, double>{0, 50.0, 0.0}}) {
+    friction_msgs::SendStageCommand call;
+    call.request.command.mode = mode;
+    call.request.command.speed = speed;
+    call.request.command.normal_force = load;
+    client.call(call);
+    g_seen.bad_command_replies.push_back(call.response);
+  }
+  ros::master::V_TopicInfo topics;
+  ros::master::getTopics(topics);
+  for (const auto& topic : topics) g_seen.topic_types[topic.name] = topic.datatype;
+  g_seen.time_after_bad_commands = g_seen.last_stage_time;
+  std::string bad_scene = "/tmp/friction_rig_bad_scene.yaml";
+  std::FILE* file = std::fopen(bad_scene.c_str(), "w");
+  std::fputs("friction: {kinetic_coefficient: 0.9}\npusher: {height: 1.0}\n", file);
+  std::fclose(file);
+  g_seen.bad_scene_status = runCommand("rosrun friction_sim rig_simulator __name:=bad_scene _scene:=" + bad_scene,
+                                       g_seen.bad_scene_output);
+  ros::NodeHandle pnh("~");
+  std::string scene;
+  pnh.getParam("scene", scene);
+  g_seen.bad_parameter_status = runCommand(
+      "rosrun friction_sim rig_simulator __name:=bad_parameter _load_cell_rate:=-1.0 _scene:=" + scene,
+      g_seen.bad_parameter_output);
+  // The controller ends the run after two global events; the simulator then closes its bag.
+  waitFor([] { return bagReadable(g_bag); }, 240.0);
+  waitFor([] { return g_seen.live_points.size() >= g_seen.events.size(); }, 10.0);
+  // Replay the bag into the second detector, under its own names.
+  std::string output;
+  runCommand("rosbag play --quiet -d 2 -r 10 --queue 1000000 " + g_bag +
+                 " --topics /rig/load_cells /rig/interface /rig/load_cells:=/replay/load_cells /rig/interface:=/replay/interface",
+             output);
+  waitFor([] { return g_seen.replay_points.size() >= g_seen.events.size(); }, 30.0);
+}
+
+void watchKilledRun(ros::NodeHandle& nh) {
+  ros::Subscriber events = listen<friction_msgs::SlipEvent>(nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); });
+  waitFor([] { return g_seen.events.size() >= 3; }, 240.0);
+  std::string output;
+  runCommand("rosnode kill /rig/simulator", output);
+  waitFor([] { return bagReadable(g_bag); }, 60.0);
+}
+
+}  // namespace
+}  // namespace friction
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "rig_run_test");
+  ros::NodeHandle nh, pnh("~");
+  std::string mode;
+  pnh.getParam("mode", mode);
+  pnh.getParam("bag", friction::g_bag);
+  if (mode == "kill") {
+    friction::watchKilledRun(nh);
+    testing::GTEST_FLAG(filter) = "KillRun.*";
+  } else {
+    friction::watchFullRun(nh);
+    testing::GTEST_FLAG(filter) = "FullRun.*";
+  }
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,105 @@
+// The ROS-free cores of the controller and the precursor detector: the loading protocol and its
+// schedule, and the instrument-only event detector against the simulator's own events.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "friction_sim/frame_event_detector.h"
+#include "friction_sim/loading_protocol.h"
+#include "friction_sim/simulation.h"
+#include "test_helpers.h"
+
+namespace friction {
+namespace {
+
+TEST(LoadingProtocol, RampHoldDriveBecomesATimedSchedule) {
+  const LoadingProtocol protocol = parseProtocol(
+      "steps:\n"
+      "  - {action: normal_load, normal_force: 2000, ramp_time: 0.01}\n"
+      "  - {action: hold, duration: 0.005}\n"
+      "  - {action: drive, speed: 4.0e-4, duration: 0.1}\n"
+      "  - {action: move_to, speed: 1.0e-3, target: 0.0, duration: .inf}\n"
+      "end: {global_events: 3}\n"
+      "ramp_commands: 4\n");
+  const auto schedule = scheduleProtocol(protocol, 1.0, 1000.0);
+  ASSERT_EQ(schedule.size(), 4u + 3u);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(schedule[k].kind, TimedCommand::Kind::NormalLoad);
+    EXPECT_DOUBLE_EQ(schedule[k].time, 1.0 + 0.0025 * k);
+    EXPECT_DOUBLE_EQ(schedule[k].normal_force, 1000.0 + 250.0 * (k + 1));
+  }
+  EXPECT_EQ(schedule[4].stage.mode, StageMode::Hold);
+  EXPECT_DOUBLE_EQ(schedule[4].time, 1.01);
+  EXPECT_EQ(schedule[5].stage.mode, StageMode::Velocity);
+  EXPECT_DOUBLE_EQ(schedule[5].time, 1.015);
+  EXPECT_EQ(schedule[6].stage.mode, StageMode::Position);
+  EXPECT_DOUBLE_EQ(schedule[6].time, 1.115);
+  EXPECT_FALSE(protocolEnded(protocol.end, 2, 0.0, 10.0));
+  EXPECT_TRUE(protocolEnded(protocol.end, 3, 0.0, 10.0));
+}
+
+TEST(LoadingProtocol, BadProtocolListsEveryProblem) {
+  try {
+    parseProtocol(
+        "steps:\n"
+        "  - {action: normal_load, normal_force: -5}\n"
+        "  - {action: drive, speed: .nan, duration: .inf}\n"
+        "  - {action: jump}\n"
+        "end: {global_events: -1, cycles: 3}\n");
+    FAIL() << "accepted";
+  } catch (const ConfigError& error) {
+    const std::string text = error.what();
+    EXPECT_EQ(error.problems().size(), 6u) << text;
+    EXPECT_NE(text.find("steps[0].normal_force: value -5"), std::string::npos) << text;
+    EXPECT_NE(text.find("steps[1].speed: value nan"), std::string::npos) << text;
+    EXPECT_NE(text.find("steps[1].duration: value inf"), std::string::npos) << text;
+    EXPECT_NE(text.find("steps[2].action: value 'jump'"), std::string::npos) << text;
+    EXPECT_NE(text.find("end.cycles: unknown key"), std::string::npos) << text;
+    EXPECT_NE(text.find("end.global_events: value -1"), std::string::npos) << text;
+  }
+}
+
+TEST(FrameEventDetector, FindsTheSimulatorsEventsFromTheInstrumentsAlone) {
+  // Frames as the simulator node publishes them: every 50 steps during events, every 0.01 s while
+  // stuck, and at every step where an event starts or ends; load cells every 1e-4 s and at those steps.
+  Simulation simulation(loadScene(testing::scenePath("pmma_1d_side")));
+  FrameEventDetector detector(simulation.scene().instruments.front_fit_nodes);
+  std::vector<SlipEvent> found;
+  double next_frame = 0.0, next_cells = 0.0;
+  while (!simulation.finished()) {
+    simulation.step();
+    const double t = simulation.time();
+    const bool boundary = simulation.eventStartedLastStep() || simulation.eventEndedLastStep();
+    if (boundary || t >= next_cells) {
+      detector.addLoadCells(simulation.loadCells());
+      if (t >= next_cells) next_cells += 1e-4;
+    }
+    if (boundary || t >= next_frame) {
+      detector.addFrame(simulation.interfaceFrame());
+      next_frame = t + (simulation.inEvent() ? 1e-5 : 1e-2);
+    }
+    for (SlipEvent& event : detector.takeCompletedEvents()) found.push_back(std::move(event));
+  }
+  EXPECT_DOUBLE_EQ(detector.sliderLength(), simulation.scene().geometry.length);
+  const auto& truth = simulation.events();
+  ASSERT_EQ(found.size(), truth.size());
+  for (std::size_t e = 0; e < truth.size(); ++e) {
+    SCOPED_TRACE("event " + std::to_string(e));
+    EXPECT_EQ(found[e].global, truth[e].global);
+    EXPECT_DOUBLE_EQ(found[e].rupture_length, truth[e].rupture_length);
+    EXPECT_DOUBLE_EQ(found[e].nucleation_position, truth[e].nucleation_position);
+    // The camera sees the onset at the end of the step; the simulator interpolates within it.
+    EXPECT_NEAR(found[e].onset_time, truth[e].onset_time, simulation.timeStep());
+    // F_X differs by at most one step of loading, K·V·dt.
+    const Scene& scene = simulation.scene();
+    const double one_step = scene.pusher.stiffness * scene.stage.program[0].speed * simulation.timeStep();
+    EXPECT_NEAR(found[e].onset_shear_force, truth[e].onset_shear_force, one_step);
+    EXPECT_DOUBLE_EQ(found[e].onset_normal_force, truth[e].onset_normal_force);
+    for (std::size_t node = 0; node < truth[e].node_slip.size(); ++node) {
+      EXPECT_NEAR(found[e].node_slip[node], truth[e].node_slip[node], 1e-12);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace friction

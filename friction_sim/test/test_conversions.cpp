@@ -1,0 +1,145 @@
+// Core structs to messages and back, command checks and node options — all without a master.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "friction_sim/ros/conversions.h"
+#include "friction_sim/ros/rig_simulator.h"
+
+namespace friction {
+namespace {
+
+TEST(Conversions, LoadCellsAreAWrenchWithFxAlongXAndFzAlongZ) {
+  LoadCellReading reading;
+  reading.time = 0.25;
+  reading.shear_force = 123.5;
+  reading.normal_force = 1920.0;
+  const auto msg = toMsg(reading, "slider");
+  EXPECT_EQ(msg.header.stamp, ros::Time(0.25));
+  EXPECT_EQ(msg.header.frame_id, "slider");
+  EXPECT_DOUBLE_EQ(msg.wrench.force.x, 123.5);
+  EXPECT_DOUBLE_EQ(msg.wrench.force.z, 1920.0);
+  EXPECT_DOUBLE_EQ(msg.wrench.force.y, 0.0);
+  const LoadCellReading back = fromMsg(msg);
+  EXPECT_DOUBLE_EQ(back.time, 0.25);
+  EXPECT_DOUBLE_EQ(back.shear_force, 123.5);
+  EXPECT_DOUBLE_EQ(back.normal_force, 1920.0);
+}
+
+TEST(Conversions, InterfaceFrameRoundTrips) {
+  InterfaceFrame frame;
+  frame.time = 1.5e-3;
+  frame.position = {0.0, 0.0025, 0.005};
+  frame.state = {0, 1, 2};
+  frame.slip_velocity = {0.0, 0.1, -0.2};
+  frame.slip = {0.0, 1e-6, 2e-6};
+  frame.normal_force = {30.0, 31.0, 0.0};
+  frame.friction_force = {-3.0, -5.27, 0.0};
+  frame.normal_stress = {2e6, 2.1e6, 0.0};
+  frame.shear_stress = {2e5, 3.5e5, 0.0};
+  const auto msg = toMsg(frame, 42, "slider");
+  EXPECT_EQ(msg.frame_index, 42u);
+  EXPECT_EQ(msg.state[1], friction_msgs::InterfaceState::SLIDING);
+  EXPECT_EQ(msg.state[2], friction_msgs::InterfaceState::DETACHED);
+  const InterfaceFrame back = fromMsg(msg);
+  EXPECT_DOUBLE_EQ(back.time, frame.time);
+  EXPECT_EQ(back.state, frame.state);
+  EXPECT_EQ(back.slip, frame.slip);
+  EXPECT_EQ(back.friction_force, frame.friction_force);
+  EXPECT_EQ(back.shear_stress, frame.shear_stress);
+}
+
+TEST(Conversions, SlipEventCarriesEveryQuantity) {
+  SlipEvent event;
+  event.index = 3;
+  event.onset_time = 0.1;
+  event.end_time = 0.1004;
+  event.onset_shear_force = 200.0;
+  event.onset_normal_force = 1920.0;
+  event.end_shear_force = 190.0;
+  event.nucleation_position = 0.0;
+  event.slip_min_x = 0.0;
+  event.slip_max_x = 0.05;
+  event.rupture_length = 0.05;
+  event.global = false;
+  event.node_slip = {1e-6, 5e-7, 0.0};
+  event.first_unstick_time = {0.1, 0.10001, std::nan("")};
+  event.front_speed = {250.0, 250.0, std::nan("")};
+  const auto msg = toMsg(event, {0.0, 0.0025, 0.005}, 0.14, WaveSpeeds{890.0, 968.0}, "slider");
+  EXPECT_EQ(msg.header.stamp, ros::Time(0.1004));
+  EXPECT_DOUBLE_EQ(msg.slider_length, 0.14);
+  EXPECT_DOUBLE_EQ(msg.rayleigh_speed, 890.0);
+  const SlipEvent back = fromMsg(msg);
+  EXPECT_EQ(back.index, 3);
+  EXPECT_DOUBLE_EQ(back.onset_shear_force, 200.0);
+  EXPECT_DOUBLE_EQ(back.end_shear_force, 190.0);
+  EXPECT_DOUBLE_EQ(back.rupture_length, 0.05);
+  EXPECT_EQ(back.node_slip, event.node_slip);
+  EXPECT_TRUE(std::isnan(back.first_unstick_time[2]));
+  const auto point = toPointMsg(event, 0.14, "slider");
+  EXPECT_DOUBLE_EQ(point.shear_ratio, 200.0 / 1920.0);
+  EXPECT_DOUBLE_EQ(point.length_ratio, 0.05 / 0.14);
+  EXPECT_EQ(point.header.stamp, ros::Time(0.1));
+}
+
+TEST(Conversions, CommandsRoundTripWithTheirTime) {
+  TimedCommand load;
+  load.kind = TimedCommand::Kind::NormalLoad;
+  load.time = 0.02;
+  load.normal_force = 2500.0;
+  const auto load_msg = toMsg(load);
+  EXPECT_EQ(load_msg.mode, friction_msgs::StageCommand::NORMAL_LOAD);
+  EXPECT_EQ(fromMsg(load_msg).kind, TimedCommand::Kind::NormalLoad);
+  EXPECT_DOUBLE_EQ(fromMsg(load_msg).normal_force, 2500.0);
+  TimedCommand move;
+  move.time = 0.5;
+  move.stage = {StageMode::Position, 1e-3, 2e-4};
+  const TimedCommand back = fromMsg(toMsg(move));
+  EXPECT_EQ(back.stage.mode, StageMode::Position);
+  EXPECT_DOUBLE_EQ(back.stage.speed, 1e-3);
+  EXPECT_DOUBLE_EQ(back.stage.target, 2e-4);
+  EXPECT_DOUBLE_EQ(back.time, 0.5);
+}
+
+TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
+  const Stage stage(StageSpec{});
+  friction_msgs::StageCommand msg;
+  msg.mode = friction_msgs::StageCommand::VELOCITY;
+  msg.speed = std::nan("");
+  EXPECT_NE(checkCommand(msg, stage).find("finite"), std::string::npos);
+  msg.speed = 2.0;
+  EXPECT_NE(checkCommand(msg, stage).find("max_speed"), std::string::npos);
+  msg.speed = 4e-4;
+  EXPECT_EQ(checkCommand(msg, stage), "");
+  msg.mode = friction_msgs::StageCommand::NORMAL_LOAD;
+  msg.normal_force = -10.0;
+  EXPECT_NE(checkCommand(msg, stage).find("normal load -10 N"), std::string::npos);
+  msg.normal_force = std::numeric_limits<double>::infinity();
+  EXPECT_NE(checkCommand(msg, stage).find("finite F_Z"), std::string::npos);
+  msg.mode = 9;
+  EXPECT_NE(checkCommand(msg, stage).find("mode 9 is unknown"), std::string::npos);
+}
+
+TEST(SimulatorOptions, EveryBadParameterIsNamedWithValueAndRange) {
+  SimulatorOptions options;
+  options.scene_path = "scene.yaml";
+  EXPECT_TRUE(validateOptions(options).empty());
+  options.scene_path.clear();
+  options.real_time_factor = -1.0;
+  options.load_cell_rate = 0.0;
+  options.overrides = "pusher.height=0.01 broken";
+  const auto problems = validateOptions(options);
+  ASSERT_EQ(problems.size(), 4u);
+  EXPECT_NE(problems[0].find("~scene"), std::string::npos);
+  EXPECT_NE(problems[1].find("~real_time_factor: value -1"), std::string::npos);
+  EXPECT_NE(problems[2].find("~load_cell_rate: value 0"), std::string::npos);
+  EXPECT_NE(problems[3].find("~overrides: item 'broken'"), std::string::npos);
+  std::vector<std::string> ignored;
+  const auto overrides = parseOverrides("pusher.height=0.01  stop.global_events=3", ignored);
+  ASSERT_EQ(overrides.size(), 2u);
+  EXPECT_EQ(overrides[1].first, "stop.global_events");
+  EXPECT_EQ(overrides[1].second, "3");
+}
+
+}  // namespace
+}  // namespace friction
