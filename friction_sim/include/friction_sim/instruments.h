@@ -18,6 +18,10 @@ struct LoadCellReading {
   int sliding_nodes = 0;              ///< N_sliding
 };
 
+/// The load cells at time t between two readings, linearly (exact across a fast-forward jump, where
+/// the forces are affine in time); the counters are those of `b`.
+LoadCellReading interpolate(const LoadCellReading& a, const LoadCellReading& b, double t);
+
 /// The fast camera's frame: the interface's state per node.
 struct InterfaceFrame {
   double time = 0.0;               ///< s
@@ -52,6 +56,9 @@ struct LatticeSnapshot {
   double pusher_height = 0.0;             ///< m
   double normal_force = 0.0;              ///< N
 };
+
+/// Strain gauges at time t between two profiles at the same positions, linearly.
+GaugeProfile interpolate(const GaugeProfile& a, const GaugeProfile& b, double t);
 
 /// Energy budget since the loaded equilibrium: work in = Δelastic + Δkinetic + dissipated.
 struct EnergyBudget {

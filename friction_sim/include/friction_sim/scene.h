@@ -92,6 +92,9 @@ struct StageSpec {
 struct IntegratorSpec {
   IntegratorKind scheme = IntegratorKind::VelocityVerlet;
   double time_step = 2.0e-7;  ///< s, dt; must be below the stability limit computed from the scene
+  /// while the whole interface sticks, jump along the static equilibrium to the next threshold
+  /// crossing instead of integrating (MODEL.md §5); needs rigid sticking (interfacial_stiffness 0)
+  bool fast_forward = false;
 };
 
 struct InstrumentSpec {

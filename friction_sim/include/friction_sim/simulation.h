@@ -16,6 +16,7 @@
 #include "friction_sim/scene.h"
 #include "friction_sim/slip_events.h"
 #include "friction_sim/stage.h"
+#include "friction_sim/static_solver.h"
 
 namespace friction {
 
@@ -26,8 +27,19 @@ class Simulation : public Dynamics {
 
   /// Advances by one time step.
   void step();
-  /// Steps until the scene's stop condition holds.
+  /// Advances by one time step or, with fast-forward on while the interface sits stuck in static
+  /// equilibrium, jumps along the equilibrium to the earliest of `until` (s), the stage's next change
+  /// and just before the next node reaches its threshold (MODEL.md §5).
+  void advance(double until);
+  /// Advances until the scene's stop condition holds.
   void run();
+  /// True while the slider sits in static equilibrium with every node stuck (fast-forward can jump).
+  bool quasiStatic() const { return quasi_static_; }
+  /// True if the next `advance` may be a fast-forward jump.
+  bool mayJump() const { return quasi_static_ && !approaching_threshold_; }
+  /// Fast-forward jumps taken, and simulated time (s) they covered.
+  long long jumps() const { return jumps_; }
+  double jumpedTime() const { return jumped_time_; }
   /// True once the stop condition holds; `stopReason()` says which.
   bool finished() const { return !stop_reason_.empty(); }
   const std::string& stopReason() const { return stop_reason_; }
@@ -70,6 +82,13 @@ class Simulation : public Dynamics {
 
  private:
   void relaxToLoadedEquilibrium();
+  /// With the interface pinned where it sticks: the static equilibrium, if it holds every node within
+  /// its threshold and in contact. Applies it (the energy of the ring-down it skips is counted as
+  /// viscous dissipation) and returns true; otherwise leaves the state as it is.
+  bool relaxToStaticEquilibrium();
+  /// The jump of `advance`; returns false if a dynamic step is needed instead.
+  bool fastForward(double until);
+  void refreshAfterStaticChange();
   void reapplyFriction();
   void checkStop();
 
@@ -95,6 +114,12 @@ class Simulation : public Dynamics {
   double external_work_closed_ = 0.0;  ///< J, top-load work before the last change of F_Z
   Vector external_reference_u_;         ///< displacements at the last change of F_Z
   double viscous_dissipation_ = 0.0;
+  // Fast-forward.
+  std::unique_ptr<StaticSolver> pinned_solver_;  ///< factored once, for the interface pinned, pusher on
+  bool quasi_static_ = false;
+  bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
+  long long jumps_ = 0;
+  double jumped_time_ = 0.0;
 };
 
 }  // namespace friction

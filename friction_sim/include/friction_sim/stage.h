@@ -24,6 +24,8 @@ class Stage {
   const StageCommand& current() const { return current_; }  ///< what the stage is doing now
   /// m, where the stage will be `lead` seconds from now if nothing changes (for stages within a step).
   double positionAfter(double lead) const;
+  /// s until the stage's motion changes by itself: its program segment ends or it reaches its target.
+  double timeToNextChange() const;
 
   /// Why `command` would be refused (empty if acceptable): non-finite values, speed beyond max_speed.
   std::string checkCommand(const StageCommand& command) const;

@@ -127,6 +127,13 @@ class YamlFieldReader {
       problems_.push_back(where + ": value '" + YAML::Dump(node) + "' is not an integer");
     }
   }
+  void read(const YAML::Node& node, const std::string& where, bool& value) {
+    try {
+      value = node.as<bool>();
+    } catch (const YAML::Exception&) {
+      problems_.push_back(where + ": value '" + YAML::Dump(node) + "' is not allowed; allowed: true | false");
+    }
+  }
   void read(const YAML::Node& node, const std::string& where, std::string& value) {
     if (!node.IsScalar()) {
       problems_.push_back(where + ": expected a string");

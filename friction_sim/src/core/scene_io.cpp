@@ -108,6 +108,7 @@ void visitScene(Scene& s, Visitor& v) {
   v.section("integrator", [&] {
     v.field("scheme", s.integrator.scheme);
     v.field("time_step", s.integrator.time_step);
+    v.field("fast_forward", s.integrator.fast_forward);
   });
   v.section("instruments", [&] {
     v.field("loading_curve_rate", s.instruments.loading_curve_rate);
@@ -156,6 +157,7 @@ class YamlWriter {
     }
   }
   void write(int value) { out_ << value; }
+  void write(bool value) { out_ << (value ? "true" : "false"); }
   void write(const std::string& value) { out_ << value; }
   void write(const std::vector<double>& values) {
     out_ << YAML::Flow << YAML::BeginSeq;

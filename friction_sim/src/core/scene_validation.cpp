@@ -138,6 +138,10 @@ std::vector<std::string> validateScene(const Scene& s) {
   check.positive("stop.time", s.stop.time);
   check.require(s.stop.stage_travel > 0.0, "stop.stage_travel", s.stop.stage_travel, "a travel > 0 m (.inf allowed)");
   check.positive("integrator.time_step", s.integrator.time_step);
+  if (s.integrator.fast_forward) {
+    check.require(s.friction.interfacial_stiffness == 0.0, "friction.interfacial_stiffness",
+                  s.friction.interfacial_stiffness, "0 (rigid sticking) when integrator.fast_forward is true");
+  }
 
   // Cross-field checks that need a consistent model; run whenever the fields they use are valid, so
   // that one refusal lists everything.

@@ -1,6 +1,5 @@
 #include "friction_sim/simulation.h"
 
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -8,6 +7,7 @@
 #include <stdexcept>
 
 #include "friction_sim/scene_io.h"
+#include "friction_sim/static_solver.h"
 
 namespace friction {
 
@@ -15,6 +15,30 @@ double EnergyBudget::relativeResidual() const {
   const double scale = std::max({std::abs(work_in), std::abs(elastic - initial_elastic), kinetic,
                                  friction_dissipation, viscous_dissipation, 1e-300});
   return residual() / scale;
+}
+
+LoadCellReading interpolate(const LoadCellReading& a, const LoadCellReading& b, double t) {
+  const double w = b.time > a.time ? (t - a.time) / (b.time - a.time) : 1.0;
+  LoadCellReading out = b;
+  out.time = t;
+  out.stage_position = a.stage_position + w * (b.stage_position - a.stage_position);
+  out.shear_force = a.shear_force + w * (b.shear_force - a.shear_force);
+  out.normal_force = a.normal_force + w * (b.normal_force - a.normal_force);
+  out.interface_normal_sum = a.interface_normal_sum + w * (b.interface_normal_sum - a.interface_normal_sum);
+  return out;
+}
+
+GaugeProfile interpolate(const GaugeProfile& a, const GaugeProfile& b, double t) {
+  const double w = b.time > a.time ? (t - a.time) / (b.time - a.time) : 1.0;
+  GaugeProfile out = b;
+  out.time = t;
+  auto blend = [w](const std::vector<double>& from, std::vector<double>& to) {
+    for (std::size_t i = 0; i < to.size() && i < from.size(); ++i) to[i] = from[i] + w * (to[i] - from[i]);
+  };
+  blend(a.stress.sigma_xx, out.stress.sigma_xx);
+  blend(a.stress.sigma_zz, out.stress.sigma_zz);
+  blend(a.stress.tau_xz, out.stress.tau_xz);
+  return out;
 }
 
 namespace {
@@ -49,49 +73,122 @@ void Simulation::relaxToLoadedEquilibrium() {
   } else {
     model_->disconnectPusher();
   }
-  std::vector<char> blocked(n, 0);
-  for (int dof : model_->blockedDofsDuringLoading()) blocked[dof] = 1;
-  std::vector<int> free_dofs;
-  for (int dof = 0; dof < n; ++dof) {
-    if (!blocked[dof]) free_dofs.push_back(dof);
-  }
-  if (!free_dofs.empty()) {
-    std::vector<int> position_in_free(n, -1);
-    for (std::size_t i = 0; i < free_dofs.size(); ++i) position_in_free[free_dofs[i]] = static_cast<int>(i);
-    const SparseMatrix stiffness = model_->stiffnessMatrix();
-    std::vector<Eigen::Triplet<double>> entries;
-    for (int column = 0; column < stiffness.outerSize(); ++column) {
-      for (SparseMatrix::InnerIterator it(stiffness, column); it; ++it) {
-        const int row = position_in_free[it.row()], col = position_in_free[it.col()];
-        if (row >= 0 && col >= 0) entries.emplace_back(row, col, it.value());
-      }
-    }
-    SparseMatrix reduced(free_dofs.size(), free_dofs.size());
-    reduced.setFromTriplets(entries.begin(), entries.end());
-    Eigen::SimplicialLDLT<SparseMatrix> solver(reduced);
-    if (solver.info() != Eigen::Success) throw std::runtime_error("static solve: stiffness matrix is singular");
-    // Modified Newton: the rest-state stiffness corrects the residual of the full (geometric,
-    // one-sided) forces until they balance.
-    ForceEvaluation evaluation;
-    Vector residual(free_dofs.size());
-    const double tolerance = 1e-14 * scene_.geometry.length;
-    for (int iteration = 0; iteration < 500; ++iteration) {
-      model_->evaluate(u_, v_, 0.0, evaluation);
-      for (std::size_t i = 0; i < free_dofs.size(); ++i) {
-        residual[i] = evaluation.force[free_dofs[i]] + (prestressed ? body_force[free_dofs[i]] : 0.0);
-      }
-      const Vector correction = solver.solve(residual);
-      for (std::size_t i = 0; i < free_dofs.size(); ++i) u_[free_dofs[i]] += correction[i];
-      const bool load_changed = model_->rebalanceLoad(u_);
-      if (!load_changed && correction.lpNorm<Eigen::Infinity>() < tolerance) break;
-    }
-  }
+  StaticSolver(*model_, model_->blockedDofsDuringLoading(), true).solve(*model_, u_, 0.0, body_force);
   if (!prestressed) model_->connectPusher(u_);
   contact_.reset(u_);
   external_reference_u_ = u_;
   power_ = acceleration(u_, v_, 0.0, a_);
   if (contact_.updateStates(evaluation_, u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
   initial_elastic_ = model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_);
+  if (scene_.integrator.fast_forward) {
+    pinned_solver_ = std::make_unique<StaticSolver>(*model_, contact_.dofs());
+    quasi_static_ = contact_.slidingCount() == 0;
+  }
+}
+
+void Simulation::refreshAfterStaticChange() {
+  power_ = acceleration(u_, v_, time_, a_);
+  // Refresh every node's load ratio for the next step's threshold interpolation (no time passes).
+  if (contact_.updateStates(evaluation_, u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
+}
+
+bool Simulation::relaxToStaticEquilibrium() {
+  for (int node = 0; node < contact_.size(); ++node) {
+    if (contact_.state(node) != ContactState::Stuck) return false;
+  }
+  Vector relaxed = u_;
+  pinned_solver_->solve(*model_, relaxed, stage_.position());
+  ForceEvaluation check;
+  model_->evaluate(relaxed, Vector::Zero(u_.size()), stage_.position(), check);
+  for (int node = 0; node < contact_.size(); ++node) {
+    const double normal = check.normal_force[node];
+    const double needed = std::abs(check.force[contact_.dofs()[node]]);
+    if (normal <= 0.0 || needed > contact_.law().staticCoefficient(node) * normal) return false;
+  }
+  // What the ring-down would have dissipated: the drop in potential energy plus the kinetic energy.
+  auto potential = [&](const Vector& u) {
+    return model_->elasticEnergy(u, stage_.position()) - model_->externalWork(external_reference_u_, u);
+  };
+  viscous_dissipation_ += potential(u_) + 0.5 * model_->nodeMass() * v_.squaredNorm() - potential(relaxed);
+  u_ = relaxed;
+  v_.setZero();
+  refreshAfterStaticChange();
+  return true;
+}
+
+bool Simulation::fastForward(double until) {
+  const double horizon = std::min({until, scene_.stop.time}) - time_;
+  const double span = std::min(horizon, stage_.timeToNextChange());
+  const double speed = stage_.velocity();
+  if (!(span > dt_)) return false;
+  double jump = span;
+  Vector along = Vector::Zero(u_.size());  // du/dX_s along the equilibrium
+  bool stops_at_threshold = false;
+  if (speed != 0.0) {
+    // The pusher's force per unit stage travel, and the free nodes' response to it.
+    ForceEvaluation here, moved;
+    const Vector at_rest = Vector::Zero(u_.size());
+    model_->evaluate(u_, at_rest, stage_.position(), here);
+    model_->evaluate(u_, at_rest, stage_.position() + 1.0, moved);
+    along = pinned_solver_->response(moved.force - here.force);
+    // Friction needed and normal force of every stuck node are affine in the stage position.
+    const double probe = 1e-6 * model_->nodeSpacing();
+    model_->evaluate(u_ + probe * along, at_rest, stage_.position() + probe, moved);
+    for (int node = 0; node < contact_.size(); ++node) {
+      const int dof = contact_.dofs()[node];
+      const double mu = contact_.law().staticCoefficient(node);
+      const double force = here.force[dof], force_rate = (moved.force[dof] - force) / probe * speed;
+      const double normal = here.normal_force[node];
+      const double normal_rate = (moved.normal_force[node] - normal) / probe * speed;
+      // Times t > 0 where ±F(t) = µ_s·N(t) or N(t) = 0.
+      for (double sign : {1.0, -1.0}) {
+        const double slope = sign * force_rate - mu * normal_rate;
+        if (slope > 0.0) {
+          const double crossing = (mu * normal - sign * force) / slope;
+          if (crossing < jump) {
+            jump = crossing;
+            stops_at_threshold = true;
+          }
+        }
+      }
+      if (normal_rate < 0.0 && -normal / normal_rate < jump) {
+        jump = -normal / normal_rate;
+        stops_at_threshold = true;
+      }
+    }
+    // Stop just short of the crossing: the dynamics takes the node over its threshold.
+    if (stops_at_threshold) jump *= 1.0 - 1e-6;
+  }
+  if (!(jump > dt_)) {
+    approaching_threshold_ = stops_at_threshold;
+    return false;
+  }
+  const double shear_start = evaluation_.shear_force;
+  const double stage_start = stage_.position();
+  const double stage_end = stage_.positionAfter(jump);
+  u_ += (stage_end - stage_start) * along;
+  stage_.advance(jump);
+  time_ += jump;
+  pinned_solver_->solve(*model_, u_, stage_end);
+  // Every free node moves with the stage along the equilibrium.
+  v_ = speed * along;
+  refreshAfterStaticChange();
+  // Round-off may land a node just past its threshold: then its slip starts here.
+  detector_.update(time_, 0.0, contact_, u_, {evaluation_.shear_force, evaluation_.shear_force, evaluation_.normal_load});
+  pusher_work_ += 0.5 * (shear_start + evaluation_.shear_force) * (stage_end - stage_start);
+  ++jumps_;
+  jumped_time_ += jump;
+  approaching_threshold_ = stops_at_threshold;
+  event_started_ = detector_.inEvent();
+  event_ended_ = false;
+  if (event_started_) quasi_static_ = approaching_threshold_ = false;
+  checkStop();
+  return true;
+}
+
+void Simulation::advance(double until) {
+  if (mayJump() && fastForward(until)) return;
+  step();
 }
 
 double Simulation::acceleration(const Vector& u, const Vector& v, double t, Vector& a) {
@@ -123,11 +220,15 @@ void Simulation::step() {
   event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_,
                                  {shear_start, evaluation_.shear_force, evaluation_.normal_load});
   event_started_ = !was_in_event && (detector_.inEvent() || event_ended_);
+  if (pinned_solver_) {
+    if (event_started_) quasi_static_ = approaching_threshold_ = false;
+    if (event_ended_ && relaxToStaticEquilibrium()) quasi_static_ = true;
+  }
   checkStop();
 }
 
 void Simulation::run() {
-  while (!finished()) step();
+  while (!finished()) advance(scene_.stop.time);
 }
 
 void Simulation::checkStop() {
@@ -152,6 +253,7 @@ std::string Simulation::setNormalLoad(double normal_force) {
   external_reference_u_ = u_;
   model_->setNormalLoad(normal_force);
   power_ = acceleration(u_, v_, time_, a_);
+  if (pinned_solver_) quasi_static_ = !detector_.inEvent() && relaxToStaticEquilibrium();
   return {};
 }
 

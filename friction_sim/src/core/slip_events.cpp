@@ -23,6 +23,7 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
   const auto& unstuck = contact.unstuckLastStep();
   auto transition_time = [&](int node) { return step_start + contact.transitionFraction(node) * dt; };
   auto shear_at = [&](double time) {
+    if (dt <= 0.0) return loads.shear_end;
     return loads.shear_start + (loads.shear_end - loads.shear_start) * (time - step_start) / dt;
   };
   if (!in_event_ && !unstuck.empty()) {

@@ -1,6 +1,8 @@
 #include "friction_sim/stage.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace friction {
@@ -32,6 +34,18 @@ double Stage::positionAfter(double lead) const {
   if (current_.mode != StageMode::Position) return next;
   const bool passed = (next - current_.target) * (position_ - current_.target) < 0.0;
   return passed ? current_.target : next;
+}
+
+double Stage::timeToNextChange() const {
+  double time = std::numeric_limits<double>::infinity();
+  if (following_program_ && segment_ + 1 < spec_.program.size()) {
+    time = spec_.program[segment_].duration - segment_elapsed_;
+  }
+  const double speed = std::abs(velocity());
+  if (current_.mode == StageMode::Position && speed > 0.0) {
+    time = std::min(time, std::abs(current_.target - position_) / speed);
+  }
+  return std::max(time, 0.0);
 }
 
 std::string Stage::checkCommand(const StageCommand& command) const {

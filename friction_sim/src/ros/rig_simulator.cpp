@@ -166,20 +166,19 @@ void RigSimulator::emit(ros::Publisher& publisher, const std::string& topic, con
   if (bag_open_ && !msg.header.stamp.isZero()) bag_.write(publisher.getTopic().empty() ? topic : publisher.getTopic(), msg.header.stamp, msg);
 }
 
-void RigSimulator::publishClock() {
+void RigSimulator::publishClock(double time) {
   rosgraph_msgs::Clock clock;
-  clock.clock = toStamp(simulation_->time());
+  clock.clock = toStamp(time);
   clock_pub_.publish(clock);
 }
 
-void RigSimulator::publishStageState() {
+void RigSimulator::publishStageState(const LoadCellReading& cells) {
   const Stage& stage = simulation_->stage();
-  const LoadCellReading cells = simulation_->loadCells();
   friction_msgs::StageState msg;
-  msg.header.stamp = toStamp(simulation_->time());
+  msg.header.stamp = toStamp(cells.time);
   msg.header.frame_id = options_.frame_id;
   msg.mode = static_cast<std::uint8_t>(stage.current().mode);
-  msg.position = stage.position();
+  msg.position = cells.stage_position;
   msg.velocity = stage.velocity();
   msg.target = stage.current().target;
   msg.travel = stage.travel();
@@ -190,10 +189,28 @@ void RigSimulator::publishStageState() {
   emit(stage_pub_, "stage_state", msg);
 }
 
+void RigSimulator::publishAcrossJump(const LoadCellReading& cells_before, const GaugeProfile& gauges_before) {
+  const double t = simulation_->time();
+  const LoadCellReading cells_after = simulation_->loadCells();
+  const bool gauges = scene_.model == ModelKind::Lattice2D;
+  const GaugeProfile gauges_after = gauges ? simulation_->gaugeProfile() : GaugeProfile{};
+  // Each stream on its own grid, in time order within the stream.
+  for (; next_clock_ <= t; next_clock_ += 1.0 / options_.clock_rate) publishClock(next_clock_);
+  for (; next_load_cells_ <= t; next_load_cells_ += 1.0 / options_.load_cell_rate) {
+    emit(load_cells_pub_, "load_cells", toMsg(interpolate(cells_before, cells_after, next_load_cells_), options_.frame_id));
+  }
+  for (; gauges && next_gauges_ <= t; next_gauges_ += 1.0 / options_.gauge_rate) {
+    emit(gauges_pub_, "strain_gauges", toMsg(interpolate(gauges_before, gauges_after, next_gauges_), options_.frame_id));
+  }
+  for (; next_stage_state_ <= t; next_stage_state_ += 1.0 / options_.stage_state_rate) {
+    publishStageState(interpolate(cells_before, cells_after, next_stage_state_));
+  }
+}
+
 void RigSimulator::publishInstruments(bool event_boundary) {
   const double t = simulation_->time();
   const std::string& frame = options_.frame_id;
-  if (due(t, next_clock_, options_.clock_rate)) publishClock();
+  if (due(t, next_clock_, options_.clock_rate)) publishClock(t);
   if (due(t, next_load_cells_, options_.load_cell_rate) || event_boundary) {
     emit(load_cells_pub_, "load_cells", toMsg(simulation_->loadCells(), frame));
   }
@@ -209,7 +226,7 @@ void RigSimulator::publishInstruments(bool event_boundary) {
     emit(events_pub_, "slip_events",
          toMsg(simulation_->events().back(), interface_positions_, scene_.geometry.length, wave_speeds_, frame));
   }
-  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState();
+  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState(simulation_->loadCells());
   if (ros::WallTime::now() >= next_snapshot_ && lattice_pub_.getNumSubscribers() > 0) {
     lattice_pub_.publish(toMsg(simulation_->snapshot(), frame));
     next_snapshot_ = ros::WallTime::now() + ros::WallDuration(1.0 / options_.snapshot_rate);
@@ -297,12 +314,22 @@ void RigSimulator::run() {
       continue;
     }
     if (paused_) {
-      publishStageState();  // so that a controller learns the time and F_Z while the rig waits
+      publishStageState(simulation_->loadCells());  // so that a controller learns the time and F_Z while the rig waits
       ros::WallDuration(0.01).sleep();
       continue;
     }
     applyDueCommands();
-    simulation_->step();
+    // A fast-forward jump stops at the next interface frame and the next command; the other
+    // instruments are interpolated across it.
+    double until = next_frame_;
+    if (!pending_.empty()) until = std::min(until, pending_.begin()->first);
+    const long long jumps = simulation_->jumps();
+    const LoadCellReading cells_before = simulation_->loadCells();
+    const GaugeProfile gauges_before = simulation_->mayJump() && scene_.model == ModelKind::Lattice2D
+                                           ? simulation_->gaugeProfile()
+                                           : GaugeProfile{};
+    simulation_->advance(until);
+    if (simulation_->jumps() != jumps) publishAcrossJump(cells_before, gauges_before);
     publishInstruments(simulation_->eventStartedLastStep() || simulation_->eventEndedLastStep());
     if (options_.stop_at_scene_end && simulation_->finished()) {
       ROS_INFO_STREAM("scene ended: " << simulation_->stopReason());
@@ -310,7 +337,7 @@ void RigSimulator::run() {
     }
     pace();
   }
-  publishStageState();
+  publishStageState(simulation_->loadCells());
   printSummary(std::cout, summarize(*simulation_, (ros::WallTime::now() - start).toSec()));
   if (bag_open_) {
     bag_.close();

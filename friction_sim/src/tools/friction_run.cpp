@@ -50,10 +50,11 @@ int run(int argc, char** argv) {
   const double sample_interval = 1.0 / scene.instruments.loading_curve_rate;
   double next_sample = sample_interval;
   while (!simulation.finished()) {
-    simulation.step();
-    if (simulation.time() >= next_sample) {
-      loading.push_back(simulation.loadCells());
-      next_sample += sample_interval;
+    const friction::LoadCellReading before = simulation.loadCells();
+    simulation.advance(scene.stop.time);
+    const friction::LoadCellReading after = simulation.loadCells();
+    for (; next_sample <= after.time; next_sample += sample_interval) {
+      loading.push_back(friction::interpolate(before, after, next_sample));
     }
     if (simulation.eventEndedLastStep()) {
       const friction::SlipEvent& event = simulation.events().back();
@@ -64,6 +65,10 @@ int run(int argc, char** argv) {
     }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (scene.integrator.fast_forward) {
+    std::cout << "fast-forward: " << simulation.jumps() << " jumps covering " << simulation.jumpedTime()
+              << " s of " << simulation.time() << " s\n";
+  }
 
   std::vector<double> positions;
   for (int node = 0; node < simulation.model().interfaceNodeCount(); ++node) {

@@ -96,8 +96,11 @@ class RigSimulator {
   void advertise();
   void startSimulation();
   void publishInstruments(bool event_boundary);
-  void publishClock();
-  void publishStageState();
+  /// After a fast-forward jump: the load cells, gauges, stage state and clock at every publication time
+  /// the jump passed, interpolated (the statics are affine in time along a jump).
+  void publishAcrossJump(const LoadCellReading& cells_before, const GaugeProfile& gauges_before);
+  void publishClock(double time);
+  void publishStageState(const LoadCellReading& cells);
   void applyDueCommands();
   std::string accept(const friction_msgs::StageCommand& msg);
   void onCommand(const friction_msgs::StageCommand::ConstPtr& msg);

@@ -1,0 +1,82 @@
+// MODEL.md §5 and §7.6: the quasi-static fast-forward against full dynamics.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "friction_sim/simulation.h"
+#include "test_helpers.h"
+
+namespace friction {
+namespace {
+
+/// The coarse 2D slider of the run tests (29 × 16 nodes, 4 mm/s), full dynamics or fast-forward.
+Scene coarseSlider(bool fast_forward) {
+  Scene scene = loadScene(testing::scenePath("pmma_2d"));
+  scene.lattice.nodes_x = 29;
+  scene.lattice.nodes_z = 16;
+  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3}};
+  scene.integrator.time_step = 4e-7;
+  scene.integrator.fast_forward = fast_forward;
+  return scene;
+}
+
+TEST(FastForward, StaticJumpAgreesWithALongDampedDynamicRelaxation) {
+  // Drive 5 ms (F_X/F_Z = 0.04, below the first precursor), then hold 45 ms: the dynamic run rings
+  // down to rest where the jump lands at once.
+  Scene scene = coarseSlider(false);
+  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.005}, StageSegment{StageMode::Hold, 0.0, 0.0}};
+  Simulation dynamic(scene);
+  while (dynamic.time() < 0.05) dynamic.step();
+  scene.integrator.fast_forward = true;
+  Simulation jumping(scene);
+  jumping.advance(0.005);
+  ASSERT_EQ(jumping.jumps(), 1);
+  ASSERT_TRUE(dynamic.events().empty());
+  const double scale = dynamic.displacements().lpNorm<Eigen::Infinity>();
+  EXPECT_LT((jumping.displacements() - dynamic.displacements()).lpNorm<Eigen::Infinity>(), 1e-6 * scale);
+  EXPECT_NEAR(jumping.loadCells().shear_force, dynamic.loadCells().shear_force,
+              1e-6 * dynamic.loadCells().shear_force);
+}
+
+TEST(FastForward, AgreesWithFullDynamicsOnPrecursorsAndFirstGlobalEvent) {
+  Simulation full(coarseSlider(false)), fast(coarseSlider(true));
+  full.run();
+  fast.run();
+  ASSERT_EQ(full.globalEventCount(), 1);
+  ASSERT_EQ(fast.globalEventCount(), 1);
+  ASSERT_EQ(fast.events().size(), full.events().size());
+  // Full dynamics keeps the ring-down of each event, which the jump skips: arrest points agree to
+  // one lattice spacing, onset forces to 0.2 %.
+  const double spacing = full.model().nodeSpacing();
+  for (std::size_t e = 0; e < full.events().size(); ++e) {
+    SCOPED_TRACE("event " + std::to_string(e));
+    EXPECT_NEAR(fast.events()[e].rupture_length, full.events()[e].rupture_length, spacing + 1e-12);
+    EXPECT_NEAR(fast.events()[e].onset_shear_force, full.events()[e].onset_shear_force,
+                2e-3 * full.events()[e].onset_shear_force);
+  }
+  // Most of the loading is skipped: the steps are those of the slip events.
+  EXPECT_LT(fast.steps(), full.steps() / 10);
+  EXPECT_GT(fast.jumpedTime(), 0.8 * fast.time());
+  EXPECT_LT(std::abs(fast.energy().relativeResidual()), 1e-4);
+}
+
+TEST(FastForward, StopAndGoAndNormalLoadChangesStayOnTheStaticPath) {
+  Scene scene = coarseSlider(true);
+  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.01}, StageSegment{StageMode::Hold, 0.0, 0.0, 0.01},
+                         StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.01}};
+  Simulation simulation(scene);
+  while (simulation.time() < 0.015) simulation.advance(0.015);
+  EXPECT_NEAR(simulation.stage().position(), 4e-5, 1e-12);
+  const double shear_in_hold = simulation.loadCells().shear_force;
+  EXPECT_EQ(simulation.setNormalLoad(2500.0), "");
+  EXPECT_TRUE(simulation.quasiStatic());
+  EXPECT_NEAR(simulation.loadCells().interface_normal_sum, 2500.0, 1e-6 * 2500.0);
+  while (simulation.time() < 0.03) simulation.advance(0.03);
+  EXPECT_NEAR(simulation.stage().position(), 8e-5, 1e-12);
+  EXPECT_GT(simulation.loadCells().shear_force, shear_in_hold);
+  EXPECT_LE(simulation.jumps(), 6);
+  EXPECT_LT(simulation.steps(), 100);
+}
+
+}  // namespace
+}  // namespace friction
