@@ -1,0 +1,41 @@
+// Colours for scalar fields (the drawing-free part of the rig's displays).
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace friction_rviz {
+
+struct Rgb {
+  float r = 0, g = 0, b = 0;
+};
+
+/// A value range, fixed or taken from the data.
+struct Range {
+  double min = 0.0;
+  double max = 1.0;
+};
+
+/// The range of `values` (finite ones); a symmetric range around 0 when `symmetric`; never empty.
+Range autoRange(const std::vector<double>& values, bool symmetric);
+
+/// Maps `value` in `range` to a diverging blue–white–red colour (below/above the range: clamped;
+/// NaN: grey). Diverging, because stresses change sign.
+Rgb colorOf(double value, const Range& range);
+
+/// The fields the slider display can colour by.
+enum class Field { SigmaZZ = 0, TauXZ = 1, StressRatio = 2, VonMises = 3, Speed = 4 };
+std::string fieldLabel(Field field);  ///< with its unit
+/// True for fields that change sign (drawn with a range symmetric about zero).
+bool signedField(Field field);
+
+/// Per-node value of `field` from node stresses (Pa) and speeds (m/s): τ/σ is τ_xz/(−σ_zz) (the
+/// shear-to-compression ratio, NaN where the node is not compressed); von Mises in plane stress.
+std::vector<double> fieldValues(Field field, const std::vector<double>& sigma_xx, const std::vector<double>& sigma_zz,
+                                const std::vector<double>& tau_xz, const std::vector<double>& speed);
+
+/// Colour of an interface node by contact state: stuck blue, sliding red, contact lost grey.
+Rgb contactColor(unsigned state);
+
+}  // namespace friction_rviz

@@ -1,0 +1,97 @@
+#include "friction_rviz/color_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace friction_rviz {
+
+Range autoRange(const std::vector<double>& values, bool symmetric) {
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (double value : values) {
+    if (!std::isfinite(value)) continue;
+    low = std::min(low, value);
+    high = std::max(high, value);
+  }
+  if (!(low <= high)) return Range{};
+  if (symmetric) {
+    const double extent = std::max(std::abs(low), std::abs(high));
+    low = -extent;
+    high = extent;
+  }
+  if (high - low <= 0.0) {
+    const double pad = std::max(std::abs(high), 1.0) * 1e-6;
+    low -= pad;
+    high += pad;
+  }
+  return Range{low, high};
+}
+
+Rgb colorOf(double value, const Range& range) {
+  if (std::isnan(value)) return Rgb{0.5f, 0.5f, 0.5f};
+  const double s = std::clamp((value - range.min) / (range.max - range.min), 0.0, 1.0);
+  // Blue (0.23, 0.30, 0.75) through white to red (0.71, 0.02, 0.15), linear in each half.
+  const Rgb blue{0.23f, 0.30f, 0.75f}, white{0.95f, 0.95f, 0.95f}, red{0.71f, 0.02f, 0.15f};
+  const Rgb& from = s < 0.5 ? blue : white;
+  const Rgb& to = s < 0.5 ? white : red;
+  const float w = static_cast<float>(s < 0.5 ? 2.0 * s : 2.0 * s - 1.0);
+  return Rgb{from.r + w * (to.r - from.r), from.g + w * (to.g - from.g), from.b + w * (to.b - from.b)};
+}
+
+std::string fieldLabel(Field field) {
+  switch (field) {
+    case Field::SigmaZZ:
+      return "sigma_zz (Pa)";
+    case Field::TauXZ:
+      return "tau_xz (Pa)";
+    case Field::StressRatio:
+      return "tau/sigma";
+    case Field::VonMises:
+      return "von Mises (Pa)";
+    case Field::Speed:
+      break;
+  }
+  return "speed (m/s)";
+}
+
+bool signedField(Field field) { return field == Field::SigmaZZ || field == Field::TauXZ || field == Field::StressRatio; }
+
+std::vector<double> fieldValues(Field field, const std::vector<double>& sigma_xx, const std::vector<double>& sigma_zz,
+                                const std::vector<double>& tau_xz, const std::vector<double>& speed) {
+  const std::size_t n = field == Field::Speed ? speed.size() : sigma_zz.size();
+  std::vector<double> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    switch (field) {
+      case Field::SigmaZZ:
+        out[i] = sigma_zz[i];
+        break;
+      case Field::TauXZ:
+        out[i] = tau_xz[i];
+        break;
+      case Field::StressRatio:
+        out[i] = sigma_zz[i] < 0.0 ? tau_xz[i] / -sigma_zz[i] : std::numeric_limits<double>::quiet_NaN();
+        break;
+      case Field::VonMises:
+        out[i] = std::sqrt(sigma_xx[i] * sigma_xx[i] - sigma_xx[i] * sigma_zz[i] + sigma_zz[i] * sigma_zz[i] +
+                           3.0 * tau_xz[i] * tau_xz[i]);
+        break;
+      case Field::Speed:
+        out[i] = speed[i];
+        break;
+    }
+  }
+  return out;
+}
+
+Rgb contactColor(unsigned state) {
+  switch (state) {
+    case 0:
+      return Rgb{0.15f, 0.35f, 0.95f};
+    case 1:
+      return Rgb{0.95f, 0.15f, 0.10f};
+    default:
+      return Rgb{0.55f, 0.55f, 0.55f};
+  }
+}
+
+}  // namespace friction_rviz

@@ -1,0 +1,238 @@
+#include "rig_panel.h"
+
+#include <friction_msgs/SendStageCommand.h>
+#include <std_srvs/SetBool.h>
+
+#include <QDoubleSpinBox>
+#include <QGridLayout>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QLineEdit>
+#include <QPainter>
+#include <QPushButton>
+#include <QTimer>
+#include <QVBoxLayout>
+#include <algorithm>
+#include <cmath>
+
+#include "friction_rviz/commands.h"
+
+namespace friction_rviz {
+
+PlotWidget::PlotWidget(const QString& x_label, const QString& y_label, QWidget* parent)
+    : QWidget(parent), x_label_(x_label), y_label_(y_label) {
+  setMinimumHeight(120);
+}
+
+void PlotWidget::setSeries(std::vector<Series> series) {
+  series_ = std::move(series);
+  update();
+}
+
+void PlotWidget::paintEvent(QPaintEvent*) {
+  QPainter painter(this);
+  painter.fillRect(rect(), Qt::white);
+  const QRectF area(46, 8, width() - 56, height() - 34);
+  painter.setPen(Qt::gray);
+  painter.drawRect(area);
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+  for (const Series& s : series_) {
+    for (double v : s.x) x0 = std::min(x0, v), x1 = std::max(x1, v);
+    for (double v : s.y) y0 = std::min(y0, v), y1 = std::max(y1, v);
+  }
+  painter.setPen(Qt::black);
+  painter.drawText(QRectF(area.left(), area.bottom() + 4, area.width(), 16), Qt::AlignCenter, x_label_);
+  painter.save();
+  painter.translate(12, area.center().y());
+  painter.rotate(-90);
+  painter.drawText(QRectF(-area.height() / 2, -10, area.height(), 16), Qt::AlignCenter, y_label_);
+  painter.restore();
+  if (!(x0 < x1)) return;
+  y0 = std::min(y0, 0.0);
+  if (!(y0 < y1)) y1 = y0 + 1.0;
+  painter.drawText(QRectF(0, area.top() - 2, 44, 14), Qt::AlignRight, QString::number(y1, 'g', 3));
+  painter.drawText(QRectF(0, area.bottom() - 12, 44, 14), Qt::AlignRight, QString::number(y0, 'g', 3));
+  auto map = [&](double x, double y) {
+    return QPointF(area.left() + (x - x0) / (x1 - x0) * area.width(), area.bottom() - (y - y0) / (y1 - y0) * area.height());
+  };
+  for (const Series& s : series_) {
+    painter.setPen(QPen(s.colour, 1.5));
+    painter.setBrush(s.colour);
+    if (s.points) {
+      for (std::size_t i = 0; i < s.x.size(); ++i) painter.drawEllipse(map(s.x[i], s.y[i]), 3, 3);
+      continue;
+    }
+    // One vertex per horizontal pixel at most: drawing stays cheap at any data rate.
+    QPolygonF line;
+    double last_pixel = -1;
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      const QPointF p = map(s.x[i], s.y[i]);
+      if (p.x() - last_pixel < 1.0 && i + 1 < s.x.size()) continue;
+      last_pixel = p.x();
+      line << p;
+    }
+    painter.drawPolyline(line);
+  }
+}
+
+RigPanel::RigPanel(QWidget* parent) : rviz::Panel(parent) {
+  auto* layout = new QVBoxLayout;
+  auto* top = new QHBoxLayout;
+  top->addWidget(new QLabel("Rig namespace"));
+  namespace_edit_ = new QLineEdit("/rig");
+  top->addWidget(namespace_edit_);
+  layout->addLayout(top);
+  loading_plot_ = new PlotWidget("t (s)", "F_X, F_Z (N)");
+  precursor_plot_ = new PlotWidget("F_X / F_Z", "L_p / L");
+  layout->addWidget(loading_plot_);
+  layout->addWidget(precursor_plot_);
+  state_label_ = new QLabel("stage: waiting for /rig/stage_state");
+  layout->addWidget(state_label_);
+  auto* controls = new QGridLayout;
+  speed_ = new QDoubleSpinBox;
+  speed_->setRange(-1000.0, 1000.0);
+  speed_->setDecimals(3);
+  speed_->setValue(0.4);
+  speed_->setSuffix(" mm/s");
+  target_ = new QDoubleSpinBox;
+  target_->setRange(-100.0, 100.0);
+  target_->setDecimals(4);
+  target_->setSuffix(" mm");
+  normal_load_ = new QDoubleSpinBox;
+  normal_load_->setRange(-100.0, 100.0);
+  normal_load_->setDecimals(3);
+  normal_load_->setValue(1.92);
+  normal_load_->setSuffix(" kN");
+  auto button = [&](const char* text, const char* slot) {
+    auto* b = new QPushButton(text);
+    connect(b, SIGNAL(clicked()), this, slot);
+    return b;
+  };
+  controls->addWidget(speed_, 0, 0);
+  controls->addWidget(button("Drive", SLOT(drive())), 0, 1);
+  controls->addWidget(button("Hold", SLOT(hold())), 0, 2);
+  controls->addWidget(target_, 1, 0);
+  controls->addWidget(button("Move to", SLOT(moveTo())), 1, 1);
+  controls->addWidget(button("Pause / resume", SLOT(togglePause())), 1, 2);
+  controls->addWidget(normal_load_, 2, 0);
+  controls->addWidget(button("Set F_Z", SLOT(setNormalLoad())), 2, 1);
+  layout->addLayout(controls);
+  reply_label_ = new QLabel("reply: -");
+  reply_label_->setWordWrap(true);
+  layout->addWidget(reply_label_);
+  setLayout(layout);
+  connect(namespace_edit_, SIGNAL(editingFinished()), this, SLOT(connectToRig()));
+  auto* timer = new QTimer(this);
+  connect(timer, SIGNAL(timeout()), this, SLOT(refresh()));
+  timer->start(100);  // redraw at 10 Hz whatever the data rate
+  connectToRig();
+}
+
+void RigPanel::connectToRig() {
+  const std::string ns = namespace_edit_->text().toStdString();
+  ros::NodeHandle rig(ns);
+  load_cells_sub_ = rig.subscribe("load_cells", 100, &RigPanel::onLoadCells, this);
+  events_sub_ = rig.subscribe("slip_events", 100, &RigPanel::onEvent, this);
+  stage_sub_ = rig.subscribe("stage_state", 10, &RigPanel::onStageState, this);
+  command_client_ = rig.serviceClient<friction_msgs::SendStageCommand>("send_command");
+  pause_client_ = rig.serviceClient<std_srvs::SetBool>("pause");
+  shear_.clear();
+  normal_.clear();
+  shear_ratio_.clear();
+  length_ratio_.clear();
+  global_.clear();
+  Q_EMIT configChanged();
+}
+
+void RigPanel::onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
+  const double t = msg->header.stamp.toSec();
+  if (shear_.add(t, msg->wrench.force.x)) {
+    // Time jumped back (looped playback or a reset): the panel starts over.
+    normal_.clear();
+    shear_ratio_.clear();
+    length_ratio_.clear();
+    global_.clear();
+  }
+  normal_.add(t, msg->wrench.force.z);
+}
+
+void RigPanel::onEvent(const friction_msgs::SlipEvent::ConstPtr& msg) {
+  shear_ratio_.push_back(msg->onset_shear_force / msg->onset_normal_force);
+  length_ratio_.push_back(msg->rupture_length / msg->slider_length);
+  global_.push_back(msg->global_event);
+}
+
+void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
+  last_state_ = *msg;
+  paused_ = msg->paused;
+}
+
+void RigPanel::refresh() {
+  auto series = [](const SeriesHistory& h, QColor colour) {
+    PlotWidget::Series s;
+    s.x.assign(h.times().begin(), h.times().end());
+    s.y.assign(h.values().begin(), h.values().end());
+    s.colour = colour;
+    return s;
+  };
+  loading_plot_->setSeries({series(shear_, QColor(20, 20, 20)), series(normal_, QColor(60, 120, 200))});
+  PlotWidget::Series precursors, global;
+  precursors.colour = QColor(40, 90, 220);
+  global.colour = QColor(210, 30, 30);
+  precursors.points = global.points = true;
+  for (std::size_t i = 0; i < shear_ratio_.size(); ++i) {
+    auto& s = global_[i] ? global : precursors;
+    s.x.push_back(shear_ratio_[i]);
+    s.y.push_back(length_ratio_[i]);
+  }
+  precursor_plot_->setSeries({precursors, global});
+  const char* modes[] = {"velocity", "hold", "position"};
+  state_label_->setText(QString("stage: t = %1 s, %2, X_s = %3 mm, V = %4 mm/s, F_X = %5 N, F_Z = %6 N, "
+                                "global events %7%8")
+                            .arg(last_state_.header.stamp.toSec(), 0, 'f', 4)
+                            .arg(modes[std::min<int>(last_state_.mode, 2)])
+                            .arg(last_state_.position * 1e3, 0, 'f', 4)
+                            .arg(last_state_.velocity * 1e3, 0, 'f', 3)
+                            .arg(last_state_.shear_force, 0, 'f', 1)
+                            .arg(last_state_.normal_force, 0, 'f', 1)
+                            .arg(last_state_.global_events)
+                            .arg(last_state_.paused ? " (paused)" : ""));
+}
+
+void RigPanel::send(const friction_msgs::StageCommand& command) {
+  friction_msgs::SendStageCommand call;
+  call.request.command = command;
+  const bool ok = command_client_.call(call);
+  reply_label_->setText(QString::fromStdString("reply: " + replyText(ok, call.response.accepted, call.response.reason)));
+}
+
+void RigPanel::drive() { send(driveCommand(speed_->value())); }
+void RigPanel::hold() { send(holdCommand()); }
+void RigPanel::moveTo() { send(moveCommand(target_->value(), std::abs(speed_->value()))); }
+void RigPanel::setNormalLoad() { send(normalLoadCommand(normal_load_->value())); }
+
+void RigPanel::togglePause() {
+  std_srvs::SetBool call;
+  call.request.data = !paused_;
+  const bool ok = pause_client_.call(call);
+  reply_label_->setText(ok ? "reply: " + QString::fromStdString(call.response.message) : "reply: no reply from pause");
+}
+
+void RigPanel::load(const rviz::Config& config) {
+  rviz::Panel::load(config);
+  QString ns;
+  if (config.mapGetString("Namespace", &ns)) {
+    namespace_edit_->setText(ns);
+    connectToRig();
+  }
+}
+
+void RigPanel::save(rviz::Config config) const {
+  rviz::Panel::save(config);
+  config.mapSetValue("Namespace", namespace_edit_->text());
+}
+
+}  // namespace friction_rviz
+
+#include <pluginlib/class_list_macros.hpp>
+PLUGINLIB_EXPORT_CLASS(friction_rviz::RigPanel, rviz::Panel)
