@@ -16,7 +16,7 @@ else
   ros=(catkin python3-catkin-pkg ros-core-dev librosbag-dev python3-rosbag python3-rostest python3-roslaunch
        python3-rosnode rosbash ros-message-generation libstd-msgs-dev libstd-srvs-dev python3-std-srvs
        libgeometry-msgs-dev libvisualization-msgs-dev libros-rosgraph-msgs-dev librviz-dev pluginlib-dev
-       tf2-tools)
+       tf2-tools rviz)
 fi
 
 missing=()

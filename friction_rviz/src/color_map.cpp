@@ -14,7 +14,8 @@ Range autoRange(const std::vector<double>& values, bool symmetric) {
     high = std::max(high, value);
   }
   if (!(low <= high)) return Range{};
-  if (symmetric) {
+  // Symmetric about zero only when the values change sign: an all-compressive σ_zz keeps its contrast.
+  if (symmetric && low < 0.0 && high > 0.0) {
     const double extent = std::max(std::abs(low), std::abs(high));
     low = -extent;
     high = extent;

@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "friction_rviz/color_map.h"
+#include "vertex_colour_material.h"
 
 namespace friction_rviz {
 
@@ -60,6 +61,8 @@ void InterfaceDisplay::processMessage(const friction_msgs::InterfaceState::Const
   Ogre::Quaternion orientation;
   if (!context_->getFrameManager()->getTransform(msg->header, position, orientation)) {
     setStatus(rviz::StatusProperty::Error, "Transform", "no transform to the fixed frame");
+    ROS_ERROR_THROTTLE(5.0, "friction_rviz InterfaceStrip: no transform from '%s' to the fixed frame",
+                       msg->header.frame_id.c_str());
     return;
   }
   setStatus(rviz::StatusProperty::Ok, "Transform", "OK");
@@ -95,7 +98,7 @@ void InterfaceDisplay::redraw() {
   const double half = 0.5 * (x[1] - x[0]);
   // Newest row at the base, older rows above it.
   auto row_z = [&](std::size_t r) { return base + row_height * static_cast<float>(rows - 1 - r); };
-  strip_->begin("BaseWhiteNoLighting", Ogre::RenderOperation::OT_TRIANGLE_LIST, "rviz");
+  strip_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_TRIANGLE_LIST, Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
   for (std::size_t r = 0; r < rows; ++r) {
     const auto& row = history_.row(r);
     const float z0 = row_z(r), z1 = z0 + row_height;
@@ -116,7 +119,7 @@ void InterfaceDisplay::redraw() {
   // Event outlines: a box over the event's rows and slipped range; its top edge marks L_p.
   const std::vector<StripEvent> events = history_.visibleEvents();
   if (events.empty()) return;
-  strip_->begin("BaseWhiteNoLighting", Ogre::RenderOperation::OT_LINE_LIST, "rviz");
+  strip_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_LINE_LIST, Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
   const Ogre::ColourValue outline(0.2f, 0.9f, 1.0f);
   for (const StripEvent& event : events) {
     const float xa = static_cast<float>(event.x_min - half), xb = static_cast<float>(event.x_max + half);

@@ -14,12 +14,11 @@
 #include <sstream>
 
 #include "friction_rviz/color_map.h"
+#include "vertex_colour_material.h"
 
 namespace friction_rviz {
 
 namespace {
-const char* kMaterial = "BaseWhiteNoLighting";
-
 std::string shortNumber(double value) {
   std::ostringstream text;
   text << std::setprecision(3) << value;
@@ -64,12 +63,13 @@ void SliderDisplay::onInitialize() {
   scene_node_->attachObject(lattice_);
   scene_node_->attachObject(overlay_);
   label_node_ = scene_node_->createChildSceneNode();
-  min_label_ = std::make_unique<rviz::MovableText>("", "Liberation Sans", 0.006f);
-  max_label_ = std::make_unique<rviz::MovableText>("", "Liberation Sans", 0.006f);
-  title_label_ = std::make_unique<rviz::MovableText>("", "Liberation Sans", 0.006f);
+  min_label_ = std::make_unique<rviz::MovableText>("", "Liberation Sans", 0.008f, Ogre::ColourValue::Black);
+  max_label_ = std::make_unique<rviz::MovableText>("", "Liberation Sans", 0.008f, Ogre::ColourValue::Black);
+  title_label_ = std::make_unique<rviz::MovableText>("", "Liberation Sans", 0.008f, Ogre::ColourValue::Black);
+  // One scene node per label: Ogre refuses two unnamed texts on one node.
   for (auto* label : {min_label_.get(), max_label_.get(), title_label_.get()}) {
     label->setTextAlignment(rviz::MovableText::H_LEFT, rviz::MovableText::V_CENTER);
-    label_node_->attachObject(label);
+    label_node_->createChildSceneNode()->attachObject(label);
   }
 }
 
@@ -92,6 +92,8 @@ void SliderDisplay::processMessage(const friction_msgs::LatticeSnapshot::ConstPt
   if (!context_->getFrameManager()->getTransform(msg->header, position, orientation)) {
     setStatus(rviz::StatusProperty::Error, "Transform", QString("no transform from '") +
                                                             QString::fromStdString(msg->header.frame_id) + "'");
+    ROS_ERROR_THROTTLE(5.0, "friction_rviz Slider: no transform from '%s' to the fixed frame",
+                       msg->header.frame_id.c_str());
     return;
   }
   setStatus(rviz::StatusProperty::Ok, "Transform", "OK");
@@ -114,6 +116,7 @@ void SliderDisplay::redraw() {
   const std::size_t n = m.x.size();
   if (nx < 1 || nz < 1 || n != static_cast<std::size_t>(nx) * nz || m.z.size() != n) {
     setStatus(rviz::StatusProperty::Error, "Snapshot", "node arrays do not match nodes_x * nodes_z");
+    ROS_ERROR_THROTTLE(5.0, "friction_rviz Slider: node arrays do not match nodes_x * nodes_z");
     return;
   }
   setStatus(rviz::StatusProperty::Ok, "Snapshot", QString("%1 x %2 nodes").arg(nx).arg(nz));
@@ -123,18 +126,21 @@ void SliderDisplay::redraw() {
                                              : Range{range_min_->getFloat(), range_max_->getFloat()};
   const double gain = magnification_->getFloat();
   const double l = m.spacing;
-  // Drawn position: rest position plus magnified displacement; x along the track, z up.
+  // Drawn position: rest position plus the magnified deformation. The slider's mean x displacement
+  // (its travel, which would carry the magnified drawing off the screen) is left out.
+  double mean_shift = 0.0;
+  for (std::size_t node = 0; node < n; ++node) mean_shift += (m.x[node] - (node % nx) * l) / n;
   auto point = [&](int node) {
     const int i = node % nx, j = node / nx;
     const double rest_x = i * l, rest_z = j * l;
-    return Ogre::Vector3(rest_x + gain * (m.x[node] - rest_x), 0.0f, rest_z + gain * (m.z[node] - rest_z));
+    return Ogre::Vector3(rest_x + gain * (m.x[node] - rest_x - mean_shift), 0.0f, rest_z + gain * (m.z[node] - rest_z));
   };
   auto colour = [&](int node) {
     const Rgb c = node < static_cast<int>(values.size()) ? colorOf(values[node], range) : Rgb{0.8f, 0.8f, 0.8f};
     return Ogre::ColourValue(c.r, c.g, c.b);
   };
   lattice_->clear();
-  lattice_->begin(kMaterial, Ogre::RenderOperation::OT_LINE_LIST, "rviz");
+  lattice_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_LINE_LIST, Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
   auto spring = [&](int a, int b) {
     lattice_->position(point(a));
     lattice_->colour(colour(a));
@@ -156,7 +162,7 @@ void SliderDisplay::redraw() {
 
   // The interface band (stuck/sliding), the pusher arrow, the top load and the colour bar.
   overlay_->clear();
-  overlay_->begin(kMaterial, Ogre::RenderOperation::OT_TRIANGLE_LIST, "rviz");
+  overlay_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_TRIANGLE_LIST, Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
   auto quad = [&](const Ogre::Vector3& a, const Ogre::Vector3& b, const Ogre::Vector3& c, const Ogre::Vector3& d,
                   const Ogre::ColourValue& colour) {
     for (const Ogre::Vector3& p : {a, b, c, a, c, d}) {

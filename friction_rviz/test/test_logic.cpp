@@ -26,6 +26,9 @@ TEST(ColorMap, AutomaticRangeIsSymmetricForSignedFields) {
   const Range symmetric = autoRange({-1.0, 3.0, std::nan("")}, true);
   EXPECT_DOUBLE_EQ(symmetric.min, -3.0);
   EXPECT_DOUBLE_EQ(symmetric.max, 3.0);
+  const Range one_signed = autoRange({-3.0, -1.0}, true);
+  EXPECT_DOUBLE_EQ(one_signed.min, -3.0);
+  EXPECT_DOUBLE_EQ(one_signed.max, -1.0);
   const Range plain = autoRange({1.0, 3.0}, false);
   EXPECT_DOUBLE_EQ(plain.min, 1.0);
   EXPECT_DOUBLE_EQ(plain.max, 3.0);

@@ -17,7 +17,8 @@ struct Range {
   double max = 1.0;
 };
 
-/// The range of `values` (finite ones); a symmetric range around 0 when `symmetric`; never empty.
+/// The range of `values` (finite ones); symmetric about 0 when `symmetric` and the values change
+/// sign; never empty.
 Range autoRange(const std::vector<double>& values, bool symmetric);
 
 /// Maps `value` in `range` to a diverging blue–white–red colour (below/above the range: clamped;

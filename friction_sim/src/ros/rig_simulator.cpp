@@ -65,7 +65,7 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
       {"load_cell_rate", o.load_cell_rate},   {"gauge_rate", o.gauge_rate},
       {"interface_rate", o.interface_rate},   {"interface_idle_rate", o.interface_idle_rate},
       {"stage_state_rate", o.stage_state_rate}, {"clock_rate", o.clock_rate},
-      {"snapshot_rate", o.snapshot_rate}};
+      {"lattice_rate", o.lattice_rate}, {"snapshot_rate", o.snapshot_rate}};
   for (const auto& [name, rate] : rates) require(std::isfinite(rate) && rate > 0.0, name, rate, "a rate > 0 Hz");
   if (o.frame_id.empty()) problems.push_back("~frame_id: empty; allowed: a frame name such as 'slider'");
   std::vector<std::string> override_problems;
@@ -85,6 +85,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   pnh.param("interface_idle_rate", o.interface_idle_rate, o.interface_idle_rate);
   pnh.param("stage_state_rate", o.stage_state_rate, o.stage_state_rate);
   pnh.param("clock_rate", o.clock_rate, o.clock_rate);
+  pnh.param("lattice_rate", o.lattice_rate, o.lattice_rate);
   pnh.param("snapshot_rate", o.snapshot_rate, o.snapshot_rate);
   pnh.param("bag", o.bag_path, o.bag_path);
   pnh.param("frame_id", o.frame_id, o.frame_id);
@@ -136,7 +137,7 @@ void RigSimulator::startSimulation() {
     interface_positions_.push_back(simulation_->model().interfacePosition(node));
   }
   pending_.clear();
-  next_load_cells_ = next_gauges_ = next_frame_ = next_stage_state_ = next_clock_ = 0.0;
+  next_load_cells_ = next_gauges_ = next_frame_ = next_stage_state_ = next_clock_ = next_lattice_ = 0.0;
   next_snapshot_ = ros::WallTime::now();
   pace_origin_wall_ = ros::WallTime::now();
   pace_origin_sim_ = 0.0;
@@ -227,7 +228,10 @@ void RigSimulator::publishInstruments(bool event_boundary) {
          toMsg(simulation_->events().back(), interface_positions_, scene_.geometry.length, wave_speeds_, frame));
   }
   if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState(simulation_->loadCells());
-  if (ros::WallTime::now() >= next_snapshot_ && lattice_pub_.getNumSubscribers() > 0) {
+  if (due(t, next_lattice_, options_.lattice_rate)) {
+    emit(lattice_pub_, "lattice", toMsg(simulation_->snapshot(), frame));
+  } else if (ros::WallTime::now() >= next_snapshot_ && lattice_pub_.getNumSubscribers() > 0) {
+    // Live viewers also get snapshots at a visual rate; the bag keeps the simulated-time grid.
     lattice_pub_.publish(toMsg(simulation_->snapshot(), frame));
     next_snapshot_ = ros::WallTime::now() + ros::WallDuration(1.0 / options_.snapshot_rate);
   }
@@ -315,13 +319,14 @@ void RigSimulator::run() {
     }
     if (paused_) {
       publishStageState(simulation_->loadCells());  // so that a controller learns the time and F_Z while the rig waits
-      ros::WallDuration(0.01).sleep();
+      if (lattice_pub_.getNumSubscribers() > 0) lattice_pub_.publish(toMsg(simulation_->snapshot(), options_.frame_id));
+      ros::WallDuration(0.05).sleep();
       continue;
     }
     applyDueCommands();
     // A fast-forward jump stops at the next interface frame and the next command; the other
     // instruments are interpolated across it.
-    double until = next_frame_;
+    double until = std::min(next_frame_, next_lattice_);
     if (!pending_.empty()) until = std::min(until, pending_.begin()->first);
     const long long jumps = simulation_->jumps();
     const LoadCellReading cells_before = simulation_->loadCells();

@@ -10,7 +10,8 @@
 //   interface_idle_rate (double, 100)  Hz of simulated time, interface frames while all is stuck
 //   stage_state_rate (double, 1e3)  Hz of simulated time, stage_state
 //   clock_rate (double, 1e4)        Hz of simulated time, /clock
-//   snapshot_rate (double, 20)      Hz of wall time, lattice snapshots for visualisation
+//   lattice_rate (double, 200)      Hz of simulated time, lattice snapshots (also written to the bag)
+//   snapshot_rate (double, 20)      Hz of wall time, extra lattice snapshots while someone watches live
 //   bag (string, "")                write every instrument topic to this bag, independent of subscribers
 //   frame_id (string, "slider")     frame of every message
 //   stop_at_scene_end (bool, true)  end when the scene's stop condition holds
@@ -64,6 +65,7 @@ struct SimulatorOptions {
   double interface_idle_rate = 100.0;  ///< Hz, simulated, while all is stuck
   double stage_state_rate = 1e3;   ///< Hz, simulated
   double clock_rate = 1e4;         ///< Hz, simulated
+  double lattice_rate = 200.0;     ///< Hz, simulated
   double snapshot_rate = 20.0;     ///< Hz, wall
   std::string bag_path;            ///< "" = no bag
   std::string frame_id = "slider";
@@ -126,7 +128,8 @@ class RigSimulator {
   bool stop_ = false;
   bool reset_requested_ = false;
   std::uint32_t frame_index_ = 0;
-  double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0;
+  double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0,
+         next_lattice_ = 0;
   ros::WallTime next_snapshot_, pace_origin_wall_;
   double pace_origin_sim_ = 0.0;
   ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_;

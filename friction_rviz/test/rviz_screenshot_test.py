@@ -1,0 +1,98 @@
+#!/usr/bin/python3
+"""rostest: rviz loads rig.rviz with the rig's plugins while a short run plays, and draws it.
+
+Starts rviz (the test's DISPLAY is an Xvfb screen), takes a screenshot while every node sticks and
+another with the simulator paused in the middle of a slip event, and asserts: rviz printed no error
+(plugin not loaded, display error, exception); the slider is drawn in the 3D view; the interface band
+is blue (stuck) in the first and has red (sliding) nodes in the second.
+"""
+import os
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.image  # noqa: E402
+import numpy  # noqa: E402
+import rospy  # noqa: E402
+import rostest  # noqa: E402
+from friction_msgs.msg import InterfaceState  # noqa: E402
+from std_srvs.srv import SetBool  # noqa: E402
+
+# The 3D view's lower part, where rig.rviz puts the slider (window 1400 x 860 at the origin).
+VIEW = (slice(380, 760), slice(780, 1390))
+NOISE = ("media_export", "librospack")  # Debian's rviz asks rospack for a package it does not ship
+
+
+def screenshot(path):
+    subprocess.run(["import", "-window", "root", path], check=True)
+    image = matplotlib.image.imread(path)[..., :3]
+    return image[VIEW]
+
+
+def counts(region):
+    r, g, b = region[..., 0], region[..., 1], region[..., 2]
+    return {
+        "ink": int(((r + g + b) < 2.4).sum()),
+        "stuck_blue": int(((b > 0.85) & (r < 0.3) & (g < 0.5)).sum()),
+        "sliding_red": int(((r > 0.85) & (g < 0.3) & (b < 0.3)).sum()),
+    }
+
+
+class RvizScreenshot(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("rviz_screenshot_test")
+        cls.out = rospy.get_param("~out", tempfile.mkdtemp(prefix="friction_rviz_test_"))
+        print("screenshots in " + cls.out)
+        config = rospy.get_param("~config")
+        cls.log = open(os.path.join(cls.out, "rviz_output.txt"), "w+")
+        cls.rviz = subprocess.Popen(["rviz", "-d", config], stdout=cls.log, stderr=subprocess.STDOUT)
+        cls.sliding_frame = None
+        rospy.wait_for_service("/rig/pause", timeout=60)
+        cls.pause = rospy.ServiceProxy("/rig/pause", SetBool, persistent=True)
+        time.sleep(12.0)  # rviz starts, loads the plugins, draws the loading slider
+        cls.stuck = counts(screenshot(os.path.join(cls.out, "stuck.png")))
+        # Pause the rig from the frame callback itself, while the event is still under way.
+        rospy.Subscriber("/rig/interface", InterfaceState, cls.on_frame, queue_size=1)
+        deadline = time.time() + 120
+        while cls.sliding_frame is None and time.time() < deadline:
+            time.sleep(0.01)
+        time.sleep(3.0)
+        cls.sliding = counts(screenshot(os.path.join(cls.out, "sliding.png")))
+        cls.pause(False)
+        cls.rviz.terminate()
+        cls.rviz.wait(timeout=30)
+        cls.log.seek(0)
+        cls.output = cls.log.read()
+
+    @classmethod
+    def on_frame(cls, msg):
+        if cls.sliding_frame is None and sum(1 for s in msg.state if s == InterfaceState.SLIDING) >= 3:
+            cls.pause(True)
+            cls.sliding_frame = msg
+
+    def test_rviz_reports_no_error(self):
+        bad = [line for line in self.output.splitlines()
+               if any(word in line for word in ("ERROR", "Error", "could not be loaded", "xception"))
+               and not any(noise in line for noise in NOISE)]
+        self.assertEqual(bad, [], "rviz printed:\n" + "\n".join(bad))
+
+    def test_slider_is_drawn_in_the_view(self):
+        self.assertGreater(self.stuck["ink"], 20000, self.stuck)
+
+    def test_interface_band_is_blue_while_stuck(self):
+        self.assertGreater(self.stuck["stuck_blue"], 300, self.stuck)
+        self.assertLess(self.stuck["sliding_red"], 50, self.stuck)
+
+    def test_interface_band_turns_red_where_it_slides(self):
+        self.assertIsNotNone(self.sliding_frame)
+        self.assertGreater(self.sliding["sliding_red"], 100, self.sliding)
+
+
+if __name__ == "__main__":
+    rostest.rosrun("friction_rviz", "rviz_screenshot", RvizScreenshot, sys.argv)
