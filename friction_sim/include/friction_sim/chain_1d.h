@@ -50,6 +50,8 @@ class Chain1D : public Model {
 
  private:
   double drivingStiffness(int block) const;
+  /// N, c = 2·g·h·F_X/(L·Σξ²), the friction-induced torque's share of each block's normal force per ξ.
+  double torqueCoefficient(double shear_force) const;
 
   int n_;
   double length_, spacing_, mass_, k_, eta_, area_per_block_;

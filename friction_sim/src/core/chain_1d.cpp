@@ -31,10 +31,12 @@ Chain1D::Chain1D(const Scene& scene)
   }
 }
 
+double Chain1D::torqueCoefficient(double shear_force) const {
+  return xi_square_sum_ > 0.0 ? 2.0 * torque_share_ * pushing_height_ * shear_force / (length_ * xi_square_sum_) : 0.0;
+}
+
 std::vector<double> Chain1D::normalForces(double shear_force) const {
-  const double torque = xi_square_sum_ > 0.0
-                            ? 2.0 * torque_share_ * pushing_height_ * shear_force / (length_ * xi_square_sum_)
-                            : 0.0;
+  const double torque = torqueCoefficient(shear_force);
   std::vector<double> w(n_);
   for (int i = 0; i < n_; ++i) w[i] = normal_force_ / n_ * (1.0 + tilt_ * xi_[i]) + torque * xi_[i];
   return w;
@@ -67,9 +69,11 @@ void Chain1D::evaluate(const Vector& u, const Vector& v, double stage_position, 
   out.shear_force = shear;
   out.normal_load = normal_force_;
   out.viscous_power = viscous_power;
-  const std::vector<double> w = normalForces(shear);
   out.normal_force.resize(n_);
-  for (int i = 0; i < n_; ++i) out.normal_force[i] = std::max(0.0, w[i]);
+  const double torque = torqueCoefficient(shear);
+  for (int i = 0; i < n_; ++i) {
+    out.normal_force[i] = std::max(0.0, normal_force_ / n_ * (1.0 + tilt_ * xi_[i]) + torque * xi_[i]);
+  }
 }
 
 double Chain1D::elasticEnergy(const Vector& u, double stage_position) const {

@@ -46,6 +46,9 @@ Lattice2D::Lattice2D(const Scene& scene)
                {0, 1, k_, spacing_, 0.0, 1.0},
                {1, 1, 0.5 * k_, diagonal, c, c},
                {-1, 1, 0.5 * k_, diagonal, -c, c}};
+  bond_x_.resize(nx_);
+  bond_z_.resize(nx_);
+  bond_power_.resize(nx_);
   // Start the mattress plate where it carries F_Z with the slider undeformed.
   plate_z_ = -normal_force_ / (nx_ * mattress_k_);
 }
@@ -76,36 +79,41 @@ void Lattice2D::evaluate(const Vector& u, const Vector& v, double stage_position
   const double* vx = v.data();
   const double* vz = v.data() + n_;
   double viscous_power = 0.0;
+  // Bonds row by row: a row of bonds of one family joins two contiguous runs of nodes, so each row is
+  // a few array expressions that Eigen evaluates with SIMD packets.
+  using ConstRow = Eigen::Map<const Eigen::ArrayXd>;
+  using Row = Eigen::Map<Eigen::ArrayXd>;
   for (const BondFamily& family : families_) {
-    const double rest_x = family.ex * family.rest_length;
-    const double rest_z = family.ez * family.rest_length;
-    const double kb = family.stiffness;
-    forEachBond(family, [&](int a, int b) {
-      const double dux = ux[b] - ux[a];
-      const double duz = uz[b] - uz[a];
-      double bond_fx, bond_fz;
+    const double rest_x = family.ex * family.rest_length, rest_z = family.ez * family.rest_length;
+    const int i_begin = std::max(0, -family.di);
+    const int count = nx_ - std::max(0, family.di) - i_begin;
+    const int offset = family.dj * nx_ + family.di;
+    Row bond_x(bond_x_.data(), count), bond_z(bond_z_.data(), count), scale(bond_power_.data(), count);
+    for (int j = 0; j + family.dj < nz_; ++j) {
+      const int a0 = j * nx_ + i_begin, b0 = a0 + offset;
+      const auto dux = ConstRow(ux + b0, count) - ConstRow(ux + a0, count);
+      const auto duz = ConstRow(uz + b0, count) - ConstRow(uz + a0, count);
+      const auto dvx = ConstRow(vx + b0, count) - ConstRow(vx + a0, count);
+      const auto dvz = ConstRow(vz + b0, count) - ConstRow(vz + a0, count);
       if (geometric_) {
-        const double rx = rest_x + dux;
-        const double rz = rest_z + duz;
-        const double length = std::sqrt(rx * rx + rz * rz);
-        const double tension_per_length = kb * (length - family.rest_length) / length;
-        bond_fx = tension_per_length * rx;
-        bond_fz = tension_per_length * rz;
+        // Tension per unit length of each bond, then its force along the current bond.
+        bond_x = rest_x + dux;
+        bond_z = rest_z + duz;
+        scale = (bond_x.square() + bond_z.square()).sqrt();
+        scale = family.stiffness * (scale - family.rest_length) / scale;
+        bond_x = scale * bond_x + eta_ * dvx;
+        bond_z = scale * bond_z + eta_ * dvz;
       } else {
-        const double stretch = family.ex * dux + family.ez * duz;
-        bond_fx = kb * stretch * family.ex;
-        bond_fz = kb * stretch * family.ez;
+        scale = family.stiffness * (family.ex * dux + family.ez * duz);
+        bond_x = family.ex * scale + eta_ * dvx;
+        bond_z = family.ez * scale + eta_ * dvz;
       }
-      const double dvx = vx[b] - vx[a];
-      const double dvz = vz[b] - vz[a];
-      bond_fx += eta_ * dvx;
-      bond_fz += eta_ * dvz;
-      viscous_power += eta_ * (dvx * dvx + dvz * dvz);
-      fx[a] += bond_fx;
-      fz[a] += bond_fz;
-      fx[b] -= bond_fx;
-      fz[b] -= bond_fz;
-    });
+      viscous_power += eta_ * (dvx.square() + dvz.square()).sum();
+      Row(fx + a0, count) += bond_x;
+      Row(fz + a0, count) += bond_z;
+      Row(fx + b0, count) -= bond_x;
+      Row(fz + b0, count) -= bond_z;
+    }
   }
   double normal_sum_top = 0.0;
   for (int i = 0; i < nx_; ++i) {
