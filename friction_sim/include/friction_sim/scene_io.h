@@ -33,6 +33,10 @@ Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, 
 /// Every problem of a scene (empty when valid): ranges, cross-field constraints, dt stability.
 std::vector<std::string> validateScene(const Scene& scene);
 
+/// What is allowed but probably not meant (e.g. a slip-weakening length shorter than one lattice
+/// spacing, which the lattice cannot resolve); printed by the runner and the simulator node.
+std::vector<std::string> sceneWarnings(const Scene& scene);
+
 /// Throws SceneError if validateScene finds a problem.
 void requireValidScene(const Scene& scene);
 

@@ -174,4 +174,18 @@ std::vector<std::string> validateScene(const Scene& s) {
   return check.problems;
 }
 
+std::vector<std::string> sceneWarnings(const Scene& s) {
+  std::vector<std::string> warnings;
+  const double spacing = s.model == ModelKind::Lattice2D ? s.geometry.length / std::max(s.lattice.nodes_x - 1, 1)
+                                                         : s.geometry.length / std::max(s.chain.blocks - 1, 1);
+  if (s.friction.law == FrictionLawKind::SlipWeakening && s.friction.weakening_length > 0.0 &&
+      s.friction.weakening_length < spacing) {
+    std::ostringstream text;
+    text << "friction.weakening_length: " << s.friction.weakening_length << " m is shorter than one node spacing ("
+         << spacing << " m): the cohesive zone is not resolved and results depend on the lattice";
+    warnings.push_back(text.str());
+  }
+  return warnings;
+}
+
 }  // namespace friction

@@ -116,6 +116,7 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
   const auto overrides = parseOverrides(options_.overrides, problems);
   scene_ = loadScene(options_.scene_path);
   if (!overrides.empty()) scene_ = overrideScene(scene_, overrides);
+  for (const std::string& warning : sceneWarnings(scene_)) ROS_WARN_STREAM("scene: " << warning);
   wave_speeds_ = waveSpeedsOf(scene_);
   paused_ = options_.start_paused;
   startSimulation();

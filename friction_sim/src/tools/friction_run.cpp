@@ -41,6 +41,7 @@ int run(int argc, char** argv) {
   }
   friction::Scene scene = friction::loadScene(scene_path);
   if (!overrides.empty()) scene = friction::overrideScene(scene, overrides);
+  for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
   if (out_dir.empty()) out_dir = "results/" + scene.name;
   std::filesystem::create_directories(out_dir);
 

@@ -1,0 +1,180 @@
+#!/usr/bin/python3
+"""Regenerates docs/PERFORMANCE.md: the same scenes in every mode, wall time against error.
+
+    scripts/perf_report.py [--quick]
+
+Runs the offline runner (friction_run) on pmma_2d to its first global event in each mode (integrator
+x dt x fast-forward x spring form), compares every mode with a reference run (Verlet, dt = 50 ns,
+full dynamics), measures the fast-forward at two stage speeds and over lattice sizes, runs the Google
+Benchmark of the step, and writes the report with a Pareto plot (docs/figures/pareto.png).
+"""
+import csv
+import json
+import math
+import os
+import platform
+import re
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+RUN = os.path.join(ROOT, ".build/devel/lib/friction_sim/friction_run")
+BENCH = os.path.join(ROOT, ".build/devel/lib/friction_sim/bench_kernels")
+SCENE = os.path.join(ROOT, "friction_sim/scenes/pmma_2d.yaml")
+OUT = os.path.join(ROOT, ".build/perf")
+
+
+def run(name, settings):
+    out = os.path.join(OUT, name)
+    args = [RUN, SCENE, "--out", out]
+    for key, value in settings.items():
+        args += ["--set", "%s=%s" % (key, value)]
+    text = subprocess.run(args, check=True, capture_output=True, text=True).stdout
+    summary = open(os.path.join(out, "summary.txt")).read()
+    wall = float(re.search(r"wall time ([0-9.e+-]+) s", summary).group(1))
+    steps = int(re.search(r"in ([0-9]+) steps", summary).group(1))
+    residual = float(re.search(r"residual \(relative\): ([-0-9.e+na]+)", summary).group(1))
+    with open(os.path.join(out, "events.csv")) as handle:
+        events = list(csv.DictReader(handle))
+    nodes = 57 * 31
+    if "lattice.nodes_x" in settings:
+        nodes = int(settings["lattice.nodes_x"]) * int(settings["lattice.nodes_z"])
+    return {"name": name, "settings": settings, "wall": wall, "steps": steps, "residual": residual,
+            "events": events, "nodes": nodes, "stdout": text}
+
+
+def precursors(result):
+    out = []
+    for event in result["events"]:
+        if event["global"] == "1":
+            break
+        out.append(event)
+    return out
+
+
+def first_global(result):
+    return next((e for e in result["events"] if e["global"] == "1"), None)
+
+
+def errors(result, reference):
+    mine, ref = precursors(result), precursors(reference)
+    n = min(len(mine), len(ref))
+    shear = max([abs(float(a["onset_shear_force_N"]) / float(b["onset_shear_force_N"]) - 1) for a, b in zip(mine, ref)]
+                + [0.0])
+    length = max([abs(float(a["rupture_length_m"]) - float(b["rupture_length_m"])) for a, b in zip(mine, ref)] + [0.0])
+    g, gr = first_global(result), first_global(reference)
+    macro = abs(float(g["shear_ratio"]) / float(gr["shear_ratio"]) - 1) if g and gr else math.nan
+    speed = (abs(float(g["median_front_speed_m_s"]) / float(gr["median_front_speed_m_s"]) - 1)
+             if g and gr else math.nan)
+    return {"precursors": len(mine), "precursor_difference": len(mine) - len(ref), "shear": shear,
+            "length_mm": length * 1e3, "compared": n, "macro": macro, "front_speed": speed}
+
+
+def main():
+    quick = "--quick" in sys.argv
+    os.makedirs(OUT, exist_ok=True)
+    reference = run("reference", {"integrator.time_step": "5e-8", "integrator.fast_forward": "false"})
+    modes = []
+    for scheme in ["velocity_verlet", "rk4"]:
+        for dt in ["1e-7", "2e-7", "4e-7"] if scheme == "velocity_verlet" else ["2e-7", "4e-7"]:
+            for ff in ["true", "false"]:
+                if quick and ff == "false" and dt != "4e-7":
+                    continue
+                modes.append(("%s dt=%s ff=%s" % (scheme, dt, ff),
+                              {"integrator.scheme": scheme, "integrator.time_step": dt, "integrator.fast_forward": ff}))
+    modes.append(("velocity_verlet dt=2e-7 ff=true linearised",
+                  {"integrator.time_step": "2e-7", "integrator.fast_forward": "true", "lattice.spring_form": "linearised"}))
+    results = []
+    for name, settings in modes:
+        result = run(name.replace(" ", "_").replace("=", ""), settings)
+        result["label"] = name
+        result["errors"] = errors(result, reference)
+        results.append(result)
+        print(name, result["wall"], result["errors"], flush=True)
+    slow = run("slow_stage_ff", {"stage.program": "[{mode: velocity, speed: 1.0e-5}]", "integrator.fast_forward": "true"})
+    sizes = []
+    for nx, nz in [(57, 31), (113, 61), (225, 121), (449, 241)]:
+        if quick and nx > 113:
+            continue
+        dt = {57: "2e-7", 113: "1e-7", 225: "5e-8", 449: "2.5e-8"}[nx]
+        sizes.append(run("size_%dx%d" % (nx, nz), {"lattice.nodes_x": nx, "lattice.nodes_z": nz,
+                                                   "integrator.time_step": dt, "integrator.fast_forward": "true"}))
+    bench = subprocess.run([BENCH, "--benchmark_format=json", "--benchmark_min_time=0.5",
+                            "--benchmark_filter=latticeStep/(57|113|225|449)/|chainStep/(57|1000)$"],
+                           check=True, capture_output=True, text=True).stdout
+    bench = json.loads(bench)
+    write_report(reference, results, slow, sizes, bench)
+
+
+def write_report(reference, results, slow, sizes, bench):
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for r in results:
+        e = r["errors"]
+        err = max(e["shear"], 1e-7)
+        ax.scatter(r["wall"], err, color="tab:red" if "ff=true" in r["label"] else "tab:blue")
+        ax.annotate(r["label"].replace("velocity_verlet", "VV"), (r["wall"], err), fontsize=6)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time to the first global event (s)")
+    ax.set_ylabel("max relative error of F_X at precursor onsets")
+    ax.set_title("pmma_2d: speed against error (red: fast-forward)")
+    fig.tight_layout()
+    fig.savefig(os.path.join(ROOT, "docs/figures/pareto.png"), dpi=110)
+    lines = ["# Performance: speed against error", "",
+             "Regenerated by `scripts/perf_report.py` (about 15 minutes on the machine below).", "",
+             "## The machine", "",
+             "- %s, %s; %d cores used: 1 (every run is single-threaded)" % (platform.processor() or platform.machine(),
+                                                                           cpu_model(), os.cpu_count()),
+             "- %s; g++ -O3 -march=native (option FRICTION_SIM_NATIVE)" % platform.platform(), "",
+             "## Kernels (Google Benchmark, `bench_kernels`)", "",
+             "| case | ns per node-step (or block-step) |", "|---|---|"]
+    for b in bench["benchmarks"]:
+        value = b.get("ns_per_node_step", b.get("ns_per_block_step"))
+        lines.append("| %s | %.2f |" % (b["name"], value * 1e9 if value < 1e-3 else value))
+    lines += ["", "## Every mode against the reference", "",
+              "Scene `pmma_2d` to its first global event. Reference: velocity Verlet, dt = 50 ns, full dynamics "
+              "(%.0f s, %d steps, %d precursors, µ_s,macro = %s)." % (
+                  reference["wall"], reference["steps"], len(precursors(reference)),
+                  first_global(reference)["shear_ratio"] if first_global(reference) else "none"), "",
+              "| mode | wall (s) | steps | ns/node-step | precursors (Δ) | max ΔF_X/F_X at onsets | max ΔL_p (mm) | "
+              "Δµ_s,macro | Δ front speed | energy residual |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in results:
+        e = r["errors"]
+        lines.append("| %s | %.2f | %d | %.1f | %d (%+d) | %.1e | %.2f | %.1e | %.1e | %.1e |" % (
+            r["label"], r["wall"], r["steps"], r["wall"] / max(r["steps"], 1) / r["nodes"] * 1e9, e["precursors"],
+            e["precursor_difference"], e["shear"], e["length_mm"], e["macro"], e["front_speed"], r["residual"]))
+    lines += ["", "![Pareto front](figures/pareto.png)", "",
+              "## Fast-forward", "",
+              "| stage speed | wall with fast-forward (s) | steps | simulated time (s) |", "|---|---|---|---|"]
+    ff = next(r for r in results if r["label"] == "velocity_verlet dt=2e-7 ff=true")
+    full = next((r for r in results if r["label"] == "velocity_verlet dt=2e-7 ff=false"), None)
+    lines.append("| 0.4 mm/s | %.2f | %d | – |" % (ff["wall"], ff["steps"]))
+    lines.append("| 10 µm/s | %.2f | %d | – |" % (slow["wall"], slow["steps"]))
+    if full:
+        lines += ["", "Full dynamics at 0.4 mm/s: %.1f s (%d steps): fast-forward is %.0f× faster. At 10 µm/s full "
+                  "dynamics would need 40× the steps (%.2g steps, about %.0f s at the measured step cost; not run), "
+                  "fast-forward about the same as at 0.4 mm/s." % (
+                      full["wall"], full["steps"], full["wall"] / ff["wall"], 40 * full["steps"], 40 * full["wall"])]
+    lines += ["", "## Lattice size (fast-forward on, dt scaled with the spacing)", "",
+              "| lattice | nodes | dt (s) | wall (s) | steps | ns/node-step |", "|---|---|---|---|---|---|"]
+    for s in sizes:
+        lines.append("| %sx%s | %d | %s | %.2f | %d | %.1f |" % (
+            s["settings"]["lattice.nodes_x"], s["settings"]["lattice.nodes_z"], s["nodes"],
+            s["settings"]["integrator.time_step"], s["wall"], s["steps"], s["wall"] / max(s["steps"], 1) / s["nodes"] * 1e9))
+    open(os.path.join(ROOT, "docs/PERFORMANCE.md"), "w").write("\n".join(lines) + "\n")
+
+
+def cpu_model():
+    for line in open("/proc/cpuinfo"):
+        if line.startswith("model name"):
+            return line.split(":", 1)[1].strip()
+    return "unknown CPU"
+
+
+if __name__ == "__main__":
+    main()
