@@ -5,8 +5,8 @@
 # Runs as root, or through sudo when not root.
 set -euo pipefail
 
-common=(build-essential cmake libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev
-        python3-matplotlib xvfb xauth imagemagick)
+common=(build-essential cmake libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev parallel
+        python3-matplotlib python3-yaml xvfb xauth imagemagick)
 if [ -d /opt/ros/noetic ]; then
   ros=(ros-noetic-catkin ros-noetic-roscpp ros-noetic-rosbag ros-noetic-rostest ros-noetic-roslaunch
        ros-noetic-std-msgs ros-noetic-geometry-msgs ros-noetic-visualization-msgs ros-noetic-rosgraph-msgs

@@ -13,6 +13,7 @@
 namespace friction {
 namespace {
 
+using testing::FreeBody;
 using testing::singleBlockScene;
 
 struct SingleBlockCase {
@@ -67,24 +68,6 @@ INSTANTIATE_TEST_SUITE_P(BothIntegratorsBothDirections, SingleBlockStickSlip,
                                            SingleBlockCase{IntegratorKind::RungeKutta4, -1.0, false},
                                            SingleBlockCase{IntegratorKind::VelocityVerlet, 1.0, true},
                                            SingleBlockCase{IntegratorKind::RungeKutta4, -1.0, true}));
-
-/// Frictionless, unpushed elastic body integrated directly: u'' = F(u, u')/m.
-class FreeBody : public Dynamics {
- public:
-  explicit FreeBody(Model& model) : model_(model) { model_.disconnectPusher(); }
-  double acceleration(const Vector& u, const Vector& v, double, Vector& a) override {
-    model_.evaluate(u, v, 0.0, evaluation_);
-    a = evaluation_.force / model_.nodeMass();
-    return evaluation_.viscous_power;
-  }
-  double energy(const Vector& u, const Vector& v) const {
-    return model_.elasticEnergy(u, 0.0) + 0.5 * model_.nodeMass() * v.squaredNorm();
-  }
-
- private:
-  Model& model_;
-  ForceEvaluation evaluation_;
-};
 
 Scene chainScene(int blocks, double damping_coefficient) {
   Scene scene;

@@ -9,21 +9,10 @@
 namespace friction {
 namespace {
 
-/// The coarse 2D slider of the run tests (29 × 16 nodes, 4 mm/s), full dynamics or fast-forward.
-Scene coarseSlider(bool fast_forward) {
-  Scene scene = loadScene(testing::scenePath("pmma_2d"));
-  scene.lattice.nodes_x = 29;
-  scene.lattice.nodes_z = 16;
-  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3}};
-  scene.integrator.time_step = 4e-7;
-  scene.integrator.fast_forward = fast_forward;
-  return scene;
-}
-
 TEST(FastForward, StaticJumpAgreesWithALongDampedDynamicRelaxation) {
   // Drive 5 ms (F_X/F_Z = 0.04, below the first precursor), then hold 45 ms: the dynamic run rings
   // down to rest where the jump lands at once.
-  Scene scene = coarseSlider(false);
+  Scene scene = testing::coarseSliderScene(false);
   scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.005}, StageSegment{StageMode::Hold, 0.0, 0.0}};
   Simulation dynamic(scene);
   while (dynamic.time() < 0.05) dynamic.step();
@@ -39,7 +28,7 @@ TEST(FastForward, StaticJumpAgreesWithALongDampedDynamicRelaxation) {
 }
 
 TEST(FastForward, AgreesWithFullDynamicsOnPrecursorsAndFirstGlobalEvent) {
-  Simulation full(coarseSlider(false)), fast(coarseSlider(true));
+  Simulation full(testing::coarseSliderScene(false)), fast(testing::coarseSliderScene(true));
   full.run();
   fast.run();
   ASSERT_EQ(full.globalEventCount(), 1);
@@ -61,7 +50,7 @@ TEST(FastForward, AgreesWithFullDynamicsOnPrecursorsAndFirstGlobalEvent) {
 }
 
 TEST(FastForward, StopAndGoAndNormalLoadChangesStayOnTheStaticPath) {
-  Scene scene = coarseSlider(true);
+  Scene scene = testing::coarseSliderScene(true);
   scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.01}, StageSegment{StageMode::Hold, 0.0, 0.0, 0.01},
                          StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.01}};
   Simulation simulation(scene);

@@ -11,17 +11,6 @@
 namespace friction {
 namespace {
 
-/// The coarse 2D slider (29 × 16, l = 5 mm) driven at 4 mm/s, full dynamics.
-Scene coarse() {
-  Scene scene = loadScene(testing::scenePath("pmma_2d"));
-  scene.lattice.nodes_x = 29;
-  scene.lattice.nodes_z = 16;
-  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3}};
-  scene.integrator.time_step = 4e-7;
-  scene.integrator.fast_forward = false;
-  return scene;
-}
-
 /// Runs to the stop condition; asserts finite state and a closed energy budget (to `tolerance`).
 Simulation& expectSound(Simulation& simulation, double tolerance = 1e-4) {
   simulation.run();
@@ -33,7 +22,7 @@ Simulation& expectSound(Simulation& simulation, double tolerance = 1e-4) {
 }
 
 TEST(HardCases, TimeStepJustBelowTheLimitRunsAndJustAboveIsRefused) {
-  Scene scene = coarse();
+  Scene scene = testing::coarseSliderScene();
   scene.stop.time = 0.01;
   const double limit = sceneStabilityLimit(scene);
   scene.integrator.time_step = 0.9 * limit;
@@ -52,7 +41,7 @@ TEST(HardCases, TimeStepJustBelowTheLimitRunsAndJustAboveIsRefused) {
 TEST(HardCases, EqualStaticAndKineticFrictionAndZeroKineticFriction) {
   for (double kinetic : {0.4, 0.0}) {
     SCOPED_TRACE("mu_k = " + std::to_string(kinetic));
-    Scene scene = coarse();
+    Scene scene = testing::coarseSliderScene();
     scene.friction.kinetic_coefficient = kinetic;
     scene.stop.time = 0.06;
     Simulation simulation(scene);
@@ -64,16 +53,16 @@ TEST(HardCases, EqualStaticAndKineticFrictionAndZeroKineticFriction) {
 }
 
 TEST(HardCases, NoDampingAndAStiffFoundation) {
-  Scene undamped = coarse();
+  Scene undamped = testing::coarseSliderScene();
   undamped.material.damping_coefficient = 0.0;
   undamped.stop.time = 0.02;
   Simulation first(undamped);
   expectSound(first, 1e-3);  // undamped ringing: the quadrature error is not damped away
-  Scene stiff = coarse();
+  Scene stiff = testing::coarseSliderScene();
   stiff.lattice.foundation_ratio = 50.0;  // k_f = 100 × the default k/2
   stiff.integrator.time_step = 0.9 * sceneStabilityLimit(stiff);
   stiff.stop.time = 0.02;
-  EXPECT_LT(stiff.integrator.time_step, 0.9 * sceneStabilityLimit(coarse()));
+  EXPECT_LT(stiff.integrator.time_step, 0.9 * sceneStabilityLimit(testing::coarseSliderScene()));
   Simulation second(stiff);
   expectSound(second);
 }
@@ -81,7 +70,7 @@ TEST(HardCases, NoDampingAndAStiffFoundation) {
 TEST(HardCases, PusherAtTheBottomCornerAndAtTheTop) {
   for (double height : {0.0, 0.075}) {
     SCOPED_TRACE("h = " + std::to_string(height));
-    Scene scene = coarse();
+    Scene scene = testing::coarseSliderScene();
     scene.pusher.height = height;
     Simulation simulation(scene);
     expectSound(simulation);
@@ -91,7 +80,7 @@ TEST(HardCases, PusherAtTheBottomCornerAndAtTheTop) {
 
 TEST(HardCases, EdgeLiftsOffAndComesBack) {
   // 100 N pressed, pushed at the top: the moment lifts the trailing edge.
-  Scene scene = coarse();
+  Scene scene = testing::coarseSliderScene();
   scene.load.normal_force = 100.0;
   scene.pusher.height = 0.075;
   scene.stop.global_events = 2;
@@ -116,7 +105,7 @@ TEST(HardCases, SmallestSystems) {
   Simulation two_blocks(chain);
   expectSound(two_blocks, 1e-4);
   EXPECT_EQ(two_blocks.globalEventCount(), 3);
-  Scene lattice = coarse();
+  Scene lattice = testing::coarseSliderScene();
   lattice.lattice.nodes_x = 2;
   lattice.lattice.nodes_z = 2;
   lattice.geometry.length = lattice.geometry.height = 0.075;
@@ -128,14 +117,14 @@ TEST(HardCases, SmallestSystems) {
 }
 
 TEST(HardCases, FastStageAndSuddenStageJump) {
-  Scene fast = coarse();
+  Scene fast = testing::coarseSliderScene();
   fast.stage.max_speed = 20.0;
   fast.stage.program = {StageSegment{StageMode::Velocity, 10.0}};
   fast.stop.time = 2e-4;
   Simulation racing(fast);
   // The stage moves 4 µm per step: the trapezoid rule for the pusher's work is then good to ~1e-3.
   expectSound(racing, 5e-3);
-  Scene jump = coarse();
+  Scene jump = testing::coarseSliderScene();
   jump.stage.max_speed = 1e3;
   jump.stage.program = {StageSegment{StageMode::Position, 1e3, 5e-5}};  // 50 µm in 50 ns
   jump.stop.time = 5e-3;
@@ -162,7 +151,7 @@ TEST(HardCases, HundredStickSlipCyclesWithoutDrift) {
 }
 
 TEST(HardCases, UnresolvedWeakeningLengthIsWarned) {
-  Scene scene = coarse();
+  Scene scene = testing::coarseSliderScene();
   scene.friction.law = FrictionLawKind::SlipWeakening;
   scene.friction.weakening_length = 1e-4;  // 0.1 mm, far below l = 5 mm
   const auto warnings = sceneWarnings(scene);
@@ -173,7 +162,7 @@ TEST(HardCases, UnresolvedWeakeningLengthIsWarned) {
 }
 
 TEST(HardCases, LargeLatticeTakesAFewSteps) {
-  Scene scene = coarse();
+  Scene scene = testing::coarseSliderScene();
   scene.lattice.nodes_x = 449;
   scene.lattice.nodes_z = 241;
   scene.geometry.length = 0.0025 * 448;

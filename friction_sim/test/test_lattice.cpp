@@ -9,6 +9,7 @@
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/lattice_2d.h"
+#include "test_helpers.h"
 
 namespace friction {
 namespace {
@@ -113,25 +114,10 @@ TEST(LatticeElasticity, SimpleShearGivesShearModulusThreeEighthsOfE) {
   EXPECT_NEAR(shear_modulus, 3.0 / 8.0 * scene.material.youngs_modulus, 0.01 * shear_modulus);
 }
 
-/// Frictionless free lattice integrated directly.
-class FreeLattice : public Dynamics {
- public:
-  explicit FreeLattice(Lattice2D& lattice) : lattice_(lattice) { lattice_.disconnectPusher(); }
-  double acceleration(const Vector& u, const Vector& v, double, Vector& a) override {
-    lattice_.evaluate(u, v, 0.0, evaluation_);
-    a = evaluation_.force / lattice_.nodeMass();
-    return evaluation_.viscous_power;
-  }
-
- private:
-  Lattice2D& lattice_;
-  ForceEvaluation evaluation_;
-};
-
 TEST(LatticeWaves, PAndSWaveSpeedsFromArrivalTimes) {
   const Scene scene = freeLatticeScene(141, 141);
   Lattice2D lattice(scene);
-  FreeLattice body(lattice);
+  testing::FreeBody body(lattice);
   const int centre = 70;
   const double l = lattice.spacing();
   Vector u = Vector::Zero(lattice.dofCount()), v = u, a;

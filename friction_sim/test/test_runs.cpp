@@ -12,17 +12,6 @@ namespace {
 
 using testing::scenePath;
 
-/// A coarse 2D slider (29 × 16 nodes, l = 5 mm) driven ten times faster than the default, so that a
-/// whole run to the first global event takes about a second.
-Scene coarseSliderScene() {
-  Scene scene = loadScene(scenePath("pmma_2d"));
-  scene.lattice.nodes_x = 29;
-  scene.lattice.nodes_z = 16;
-  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3}};
-  scene.integrator.time_step = 4e-7;
-  return scene;
-}
-
 class SideDrivenChain : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -108,7 +97,7 @@ TEST_F(SideDrivenChain, EnergyBudgetCloses) {
 
 TEST(SliderRun, TwoDimensionalEnergyBudgetClosesWithEverythingOn) {
   for (IntegratorKind scheme : {IntegratorKind::VelocityVerlet, IntegratorKind::RungeKutta4}) {
-    Scene scene = coarseSliderScene();
+    Scene scene = testing::coarseSliderScene();
     scene.integrator.scheme = scheme;
     Simulation simulation(scene);
     simulation.run();
@@ -143,7 +132,7 @@ TEST(SliderRun, LoadedEquilibriumCarriesTheNormalLoadWithNoShear) {
 }
 
 TEST(SliderRun, SpringMattressCarriesTheNormalLoad) {
-  Scene scene = coarseSliderScene();
+  Scene scene = testing::coarseSliderScene();
   scene.load.top = TopLoadKind::SpringMattress;
   const Simulation simulation(scene);
   EXPECT_NEAR(simulation.loadCells().normal_force, scene.load.normal_force, 1e-9 * scene.load.normal_force);
@@ -151,7 +140,7 @@ TEST(SliderRun, SpringMattressCarriesTheNormalLoad) {
 }
 
 TEST(Determinism, SameSceneTwiceGivesIdenticalEventsAndState) {
-  for (const Scene& scene : {loadScene(scenePath("pmma_1d_side")), coarseSliderScene()}) {
+  for (const Scene& scene : {loadScene(scenePath("pmma_1d_side")), testing::coarseSliderScene()}) {
     Simulation first(scene), second(scene);
     first.run();
     second.run();

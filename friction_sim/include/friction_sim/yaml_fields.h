@@ -27,6 +27,9 @@ class ConfigError : public std::runtime_error {
   std::vector<std::string> problems_;
 };
 
+/// Parses YAML text whose top level must be a mapping; throws ConfigError about `what` otherwise.
+YAML::Node loadMapping(const std::string& text, const std::string& what);
+
 /// Reads a whole text file; adds a problem if it cannot be read.
 std::string readTextFile(const std::string& path, std::vector<std::string>& problems);
 

@@ -18,13 +18,7 @@ const EnumTable<ProtocolAction>& enumTable(ProtocolAction) {
 LoadingProtocol parseProtocol(const std::string& yaml_text) {
   LoadingProtocol protocol;
   std::vector<std::string> problems;
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& error) {
-    throw ConfigError("protocol", {std::string("YAML syntax error: ") + error.what()});
-  }
-  if (!root.IsMap()) throw ConfigError("protocol", {"protocol: expected a mapping with steps and end"});
+  const YAML::Node root = loadMapping(yaml_text, "protocol");
   YamlFieldReader reader(root, problems);
   reader.list("steps", protocol.steps, [&](ProtocolStep& step) {
     reader.field("action", step.action);

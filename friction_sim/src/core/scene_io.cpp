@@ -185,6 +185,17 @@ ConfigError::ConfigError(const std::string& what_was_refused, std::vector<std::s
       }()),
       problems_(std::move(problems)) {}
 
+YAML::Node loadMapping(const std::string& text, const std::string& what) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& error) {
+    throw ConfigError(what, {std::string("YAML syntax error: ") + error.what()});
+  }
+  if (!root.IsMap()) throw ConfigError(what, {what + ": expected a mapping at the top level"});
+  return root;
+}
+
 std::string readTextFile(const std::string& path, std::vector<std::string>& problems) {
   std::ifstream file(path);
   if (!file) {
@@ -201,11 +212,10 @@ Scene parseScene(const std::string& yaml_text, const Scene& base) {
   std::vector<std::string> problems;
   YAML::Node root;
   try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& error) {
-    throw SceneError({std::string("YAML syntax error: ") + error.what()});
+    root = loadMapping(yaml_text, "scene");
+  } catch (const ConfigError& error) {
+    throw SceneError(error.problems());
   }
-  if (!root.IsMap()) throw SceneError({"scene: expected a mapping of sections at the top level"});
   YamlFieldReader reader(root, problems);
   visitScene(scene, reader);
   reader.rejectUnknownKeys();

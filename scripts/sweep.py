@@ -1,0 +1,124 @@
+#!/usr/bin/python3
+"""sweep: runs every combination of scene parameters and collects the event tables.
+
+    scripts/sweep.py SWEEP.yaml [--jobs N] [--hosts SSHLOGINS] [--out DIR]
+
+SWEEP.yaml names a base scene, fixed overrides and the parameters to vary:
+
+    base: friction_sim/scenes/pmma_2d.yaml       # relative to the repository
+    set: {stop.global_events: 1}                  # applied to every run
+    vary:                                         # every combination runs
+      load.normal_force: [1000, 1920, 4000]
+      pusher.height: [0.0, 0.005]
+    cases:                                        # optional: parameters that change together
+      - {lattice.nodes_x: 57, lattice.nodes_z: 31}
+      - {lattice.nodes_x: 113, lattice.nodes_z: 61}
+
+Each run is an independent friction_run process. GNU parallel spreads them over the local cores
+(--jobs, default all) and, with --hosts (parallel's --sshlogin list, e.g. "2/node1,2/node2,:"), over
+other machines that have this repository built at the same path. Its job log makes a rerun skip the
+runs that finished and retry the ones that failed; a failed run is reported and the others' results
+are kept. The runs' event tables are collected into DIR/events.csv with one column per varied
+parameter (DIR defaults to sweeps/<sweep file name>).
+"""
+import argparse
+import csv
+import itertools
+import os
+import shlex
+import subprocess
+import sys
+
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+RUNNER = os.path.join(ROOT, ".build/devel/lib/friction_sim/friction_run")
+
+
+def load(path):
+    with open(path) as handle:
+        spec = yaml.safe_load(handle)
+    unknown = set(spec) - {"base", "set", "vary", "cases"}
+    if unknown or "base" not in spec:
+        sys.exit("sweep: %s: keys allowed are base (required), set, vary, cases; got %s" % (path, sorted(spec)))
+    return spec
+
+
+def combinations(spec):
+    names = list((spec.get("vary") or {}).keys())
+    values = [spec["vary"][name] for name in names]
+    for case in spec.get("cases") or [{}]:
+        for combo in itertools.product(*values):
+            yield dict(case, **dict(zip(names, combo)))
+
+
+def run_id(point):
+    def short(value):
+        text = str(value)
+        return "".join(c for c in text if c.isalnum() or c in ".-e")[:40]
+    return "_".join("%s=%s" % (name.split(".")[-1], short(value)) for name, value in point.items()) or "base"
+
+
+def command(spec, point, out_dir):
+    args = [RUNNER, os.path.join(ROOT, spec["base"]), "--out", out_dir]
+    for name, value in list((spec.get("set") or {}).items()) + list(point.items()):
+        # Strings are YAML already (e.g. a stage program); numbers and booleans are written as YAML.
+        text = value if isinstance(value, str) else yaml.safe_dump(value, default_flow_style=True)
+        args += ["--set", "%s=%s" % (name, text.strip().removesuffix("...").strip())]
+    return " ".join(shlex.quote(a) for a in args) + " > " + shlex.quote(os.path.join(out_dir, "log.txt")) + " 2>&1"
+
+
+def run(path, jobs=None, hosts=None, out=None):
+    spec = load(path)
+    out = out or os.path.join(ROOT, "sweeps", os.path.splitext(os.path.basename(path))[0])
+    points = list(combinations(spec))
+    commands = []
+    for point in points:
+        run_dir = os.path.join(out, "runs", run_id(point))
+        os.makedirs(run_dir, exist_ok=True)
+        commands.append(command(spec, point, run_dir))
+    args = ["parallel", "--joblog", os.path.join(out, "joblog.txt"), "--resume-failed", "--halt", "never"]
+    if jobs:
+        args += ["--jobs", str(jobs)]
+    if hosts:
+        args += ["--sshlogin", hosts, "--workdir", "."]
+    subprocess.run(args, input="\n".join(commands) + "\n", text=True)
+    return collect(spec, points, out)
+
+
+def collect(spec, points, out):
+    rows, failed = [], []
+    for point in points:
+        run_dir = os.path.join(out, "runs", run_id(point))
+        events = os.path.join(run_dir, "events.csv")
+        if not os.path.exists(os.path.join(run_dir, "summary.txt")):
+            failed.append(run_id(point))
+            continue
+        with open(events) as handle:
+            for row in csv.DictReader(handle):
+                rows.append(dict(point, run=run_id(point), **row))
+    if rows:
+        with open(os.path.join(out, "events.csv"), "w", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=list(rows[0].keys()))
+            writer.writeheader()
+            writer.writerows(rows)
+    for name in failed:
+        print("sweep: run %s failed; see %s" % (name, os.path.join(out, "runs", name, "log.txt")), file=sys.stderr)
+    print("sweep: %d of %d runs done, %d events in %s" % (len(points) - len(failed), len(points), len(rows),
+                                                           os.path.join(out, "events.csv")))
+    return rows, failed
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("sweep")
+    parser.add_argument("--jobs", default=None)
+    parser.add_argument("--hosts", default=None)
+    parser.add_argument("--out", default=None)
+    args = parser.parse_args()
+    rows, failed = run(args.sweep, args.jobs, args.hosts, args.out)
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()
