@@ -82,7 +82,7 @@ class Lattice2D : public Model {
   double pusher_k_per_row_;
   std::vector<double> pusher_offset_;  ///< m, u_x of each pushed node when the pusher was connected
   bool pusher_connected_ = true;
-  mutable std::vector<double> bond_x_, bond_z_, bond_power_;  ///< per-row work space of evaluate()
+  mutable Eigen::ArrayXd bond_x_, bond_z_, bond_power_;  ///< per-row work space of evaluate(), aligned
 };
 
 }  // namespace friction
