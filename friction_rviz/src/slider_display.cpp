@@ -207,6 +207,10 @@ void SliderDisplay::redraw() {
          Ogre::Vector3(bar_x, 0, z1), Ogre::ColourValue(c.r, c.g, c.b));
   }
   overlay_->end();
+  // The range also goes into the display's status: the labels need rviz's fonts, which some rviz
+  // builds do not load.
+  setStatus(rviz::StatusProperty::Ok, "Colour range",
+            QString::fromStdString(fieldLabel(field) + ": " + shortNumber(range.min) + " to " + shortNumber(range.max)));
   min_label_->setCaption(shortNumber(range.min));
   max_label_->setCaption(shortNumber(range.max));
   title_label_->setCaption(fieldLabel(field));
