@@ -6,7 +6,7 @@
 set -euo pipefail
 
 common=(build-essential cmake libeigen3-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev parallel
-        python3-matplotlib python3-yaml xvfb xauth imagemagick)
+        python3-matplotlib python3-yaml xvfb xauth imagemagick libgl1-mesa-dri)
 if [ -d /opt/ros/noetic ]; then
   ros=(ros-noetic-catkin ros-noetic-roscpp ros-noetic-rosbag ros-noetic-rostest ros-noetic-roslaunch
        ros-noetic-std-msgs ros-noetic-geometry-msgs ros-noetic-visualization-msgs ros-noetic-rosgraph-msgs
@@ -37,4 +37,4 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 echo "install_deps: installing ${missing[*]}"
 "${as_root[@]}" apt-get update -qq
-DEBIAN_FRONTEND=noninteractive "${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+DEBIAN_FRONTEND=noninteractive "${as_root[@]}" apt-get install -y -qq "${missing[@]}"
