@@ -4,9 +4,11 @@
 //
 // Writes DIR/events.csv (one row per slip event), DIR/event_nodes.csv (per event and interface node:
 // slip, first-unstick time, front speed), DIR/loading.csv (load cells at instruments.loading_curve_rate),
-// DIR/scene.yaml (the scene as run) and DIR/summary.txt (also printed). DIR defaults to
+// DIR/stresses.csv (per event, at its onset and its end: the strain gauges along x and the interface
+// stresses per node), DIR/scene.yaml (the scene as run) and DIR/summary.txt (also printed). DIR defaults to
 // results/<scene name>. `--set pusher.height=0.01` overrides one scene field (validated like the file).
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -48,6 +50,22 @@ int run(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
   friction::Simulation simulation(scene);
   std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
+  std::ofstream stresses_csv(out_dir + "/stresses.csv");
+  stresses_csv << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
+                  "interface_normal_stress_Pa,interface_shear_stress_Pa\n";
+  stresses_csv.precision(10);
+  // The stress state at an event's onset (the loaded state that gave way) and at its end.
+  auto record_stresses = [&](int event, const char* phase) {
+    const friction::GaugeProfile gauges = simulation.gaugeProfile();
+    const friction::InterfaceFrame frame = simulation.interfaceFrame();
+    for (std::size_t i = 0; i < frame.position.size(); ++i) {
+      const bool gauge = i < gauges.stress.sigma_zz.size() && gauges.position[i] == frame.position[i];
+      stresses_csv << event << ',' << phase << ',' << simulation.time() << ',' << frame.position[i] << ','
+                   << (gauge ? gauges.stress.sigma_xx[i] : NAN) << ',' << (gauge ? gauges.stress.sigma_zz[i] : NAN)
+                   << ',' << (gauge ? gauges.stress.tau_xz[i] : NAN) << ',' << frame.normal_stress[i] << ','
+                   << frame.shear_stress[i] << '\n';
+    }
+  };
   const double sample_interval = 1.0 / scene.instruments.loading_curve_rate;
   double next_sample = sample_interval;
   while (!simulation.finished()) {
@@ -57,8 +75,10 @@ int run(int argc, char** argv) {
     for (; next_sample <= after.time; next_sample += sample_interval) {
       loading.push_back(friction::interpolate(before, after, next_sample));
     }
+    if (simulation.eventStartedLastStep()) record_stresses(static_cast<int>(simulation.events().size()), "onset");
     if (simulation.eventEndedLastStep()) {
       const friction::SlipEvent& event = simulation.events().back();
+      record_stresses(event.index, "end");
       std::cout << "event " << event.index << " at t = " << event.onset_time << " s: F_X/F_Z = "
                 << event.onset_shear_force / event.onset_normal_force
                 << ", L_p/L = " << event.rupture_length / scene.geometry.length
