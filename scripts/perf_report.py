@@ -36,10 +36,15 @@ def run(name, settings, timeout=None):
     for key, value in settings.items():
         args += ["--set", "%s=%s" % (key, value)]
     text = ""
+    marker = os.path.join(out, "timed_out")
+    if os.path.exists(marker):
+        return None
     if not os.path.exists(os.path.join(out, "summary.txt")):
         try:
             text = subprocess.run(args, check=True, capture_output=True, text=True, timeout=timeout).stdout
         except subprocess.TimeoutExpired:
+            os.makedirs(out, exist_ok=True)
+            open(marker, "w").close()
             return None
     summary = open(os.path.join(out, "summary.txt")).read()
     wall = float(re.search(r"wall time ([0-9.e+-]+) s", summary).group(1))
@@ -102,7 +107,8 @@ def main():
         result["errors"] = errors(result, reference)
         results.append(result)
         print(name, result["wall"], result["errors"], flush=True)
-    slow = run("slow_stage_ff", {"stage.program": "[{mode: velocity, speed: 1.0e-5}]", "integrator.fast_forward": "true"})
+    slow = run("slow_stage_ff_100s", {"stage.program": "[{mode: velocity, speed: 1.0e-5}]", "integrator.fast_forward": "true",
+                                     "stop.time": 100})
     sizes = []
     for nx, nz in [(57, 31), (113, 61), (225, 121), (449, 241)]:
         if quick and nx > 113:
@@ -150,27 +156,30 @@ def write_report(reference, results, slow, sizes, bench):
               "(%.0f s, %d steps, %d precursors, µ_s,macro = %s)." % (
                   reference["wall"], reference["steps"], len(precursors(reference)),
                   first_global(reference)["shear_ratio"] if first_global(reference) else "none"), "",
-              "| mode | wall (s) | steps | ns/node-step | precursors (Δ) | max ΔF_X/F_X at onsets | max ΔL_p (mm) | "
+              "| mode | wall (s) | steps | wall per node-step (ns) | precursors (Δ) | max ΔF_X/F_X at onsets | max ΔL_p (mm) | "
               "Δµ_s,macro | Δ front speed | energy residual |", "|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         e = r["errors"]
         lines.append("| %s | %.2f | %d | %.1f | %d (%+d) | %.1e | %.2f | %.1e | %.1e | %.1e |" % (
             r["label"], r["wall"], r["steps"], r["wall"] / max(r["steps"], 1) / r["nodes"] * 1e9, e["precursors"],
             e["precursor_difference"], e["shear"], e["length_mm"], e["macro"], e["front_speed"], r["residual"]))
-    lines += ["", "![Pareto front](figures/pareto.png)", "",
+    lines += ["", "With fast-forward the wall time per node-step includes the static solves of the jumps, so it is "
+              "larger than the kernel's; the time to solution is what counts.", "",
+              "![Pareto front](figures/pareto.png)", "",
               "## Fast-forward", "",
-              "| stage speed | wall with fast-forward (s) | steps | simulated time (s) |", "|---|---|---|---|"]
+              "| stage speed | wall with fast-forward (s) | steps | first global event at (s) |", "|---|---|---|---|"]
     ff = next(r for r in results if r["label"] == "velocity_verlet dt=2e-7 ff=true")
     full = next((r for r in results if r["label"] == "velocity_verlet dt=2e-7 ff=false"), None)
-    lines.append("| 0.4 mm/s | %.2f | %d | – |" % (ff["wall"], ff["steps"]))
-    lines.append("| 10 µm/s | %.2f | %d | – |" % (slow["wall"], slow["steps"]))
+    lines.append("| 0.4 mm/s | %.2f | %d | %s |" % (ff["wall"], ff["steps"], first_global(ff)["onset_time_s"]))
+    g = first_global(slow)
+    lines.append("| 10 µm/s | %.2f | %d | %s |" % (slow["wall"], slow["steps"], g["onset_time_s"] if g else "no global event in 100 s"))
     if full:
         lines += ["", "Full dynamics at 0.4 mm/s: %.1f s (%d steps): fast-forward is %.0f× faster. At 10 µm/s full "
                   "dynamics would need 40× the steps (%.2g steps, about %.0f s at the measured step cost; not run), "
                   "fast-forward about the same as at 0.4 mm/s." % (
                       full["wall"], full["steps"], full["wall"] / ff["wall"], 40 * full["steps"], 40 * full["wall"])]
     lines += ["", "## Lattice size (fast-forward on, dt scaled with the spacing)", "",
-              "| lattice | nodes | dt (s) | wall (s) | steps | ns/node-step |", "|---|---|---|---|---|---|"]
+              "| lattice | nodes | dt (s) | wall (s) | steps | wall per node-step (ns) |", "|---|---|---|---|---|---|"]
     for s in sizes:
         if "timeout" in s:
             lines.append("| %sx%s | %d | %s | not finished within %d s | – | – |" % (
