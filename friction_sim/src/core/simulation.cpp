@@ -232,12 +232,15 @@ void Simulation::run() {
 }
 
 void Simulation::checkStop() {
+  // Called every step: the message is only composed once a condition holds.
+  const bool enough_events = scene_.stop.global_events > 0 && detector_.globalEventCount() >= scene_.stop.global_events;
+  if (!enough_events && time_ < scene_.stop.time && stage_.travel() < scene_.stop.stage_travel) return;
   std::ostringstream reason;
-  if (scene_.stop.global_events > 0 && detector_.globalEventCount() >= scene_.stop.global_events) {
+  if (enough_events) {
     reason << "reached " << detector_.globalEventCount() << " global slip event(s)";
   } else if (time_ >= scene_.stop.time) {
     reason << "reached the time limit of " << scene_.stop.time << " s";
-  } else if (stage_.travel() >= scene_.stop.stage_travel) {
+  } else {
     reason << "reached the stage travel limit of " << scene_.stop.stage_travel << " m";
   }
   stop_reason_ = reason.str();
