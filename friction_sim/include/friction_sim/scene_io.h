@@ -30,15 +30,17 @@ Scene loadScene(const std::string& path);
 /// ("0.01"). The result is parsed and validated like a file. Throws SceneError.
 Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides);
 
-/// Every problem of a scene (empty when valid): ranges, cross-field constraints, dt stability.
-std::vector<std::string> validateScene(const Scene& scene);
+/// Every problem of a scene (empty when valid): ranges, cross-field constraints, dt stability. When
+/// the model's own fields are valid and `stability_limit` is given, it receives the scene's stability
+/// limit (s), which the check computes anyway.
+std::vector<std::string> validateScene(const Scene& scene, double* stability_limit = nullptr);
 
 /// What is allowed but probably not meant (e.g. a slip-weakening length shorter than one lattice
 /// spacing, which the lattice cannot resolve); printed by the runner and the simulator node.
 std::vector<std::string> sceneWarnings(const Scene& scene);
 
-/// Throws SceneError if validateScene finds a problem.
-void requireValidScene(const Scene& scene);
+/// Throws SceneError if validateScene finds a problem; returns the scene's stability limit (s).
+double requireValidScene(const Scene& scene);
 
 /// The scene as YAML text that parseScene reads back to the same scene.
 std::string sceneToYaml(const Scene& scene);

@@ -81,6 +81,8 @@ class Simulation : public Dynamics {
   double acceleration(const Vector& u, const Vector& v, double t, Vector& a) override;
 
  private:
+  /// `stability_limit` (s) comes from the validation, which has computed it already.
+  Simulation(const Scene& scene, double stability_limit);
   void relaxToLoadedEquilibrium();
   /// With the interface pinned where it sticks: the static equilibrium, if it holds every node within
   /// its threshold and in contact. Applies it (the energy of the ring-down it skips is counted as

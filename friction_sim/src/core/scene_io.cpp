@@ -268,9 +268,11 @@ std::string sceneToYaml(const Scene& scene) {
   return std::string(out.c_str()) + "\n";
 }
 
-void requireValidScene(const Scene& scene) {
-  auto problems = validateScene(scene);
+double requireValidScene(const Scene& scene) {
+  double limit = 0.0;
+  auto problems = validateScene(scene, &limit);
   if (!problems.empty()) throw SceneError(problems);
+  return limit;
 }
 
 }  // namespace friction

@@ -46,7 +46,7 @@ class Checker {
 
 }  // namespace
 
-std::vector<std::string> validateScene(const Scene& s) {
+std::vector<std::string> validateScene(const Scene& s, double* stability_limit) {
   Checker check;
   const bool lattice = s.model == ModelKind::Lattice2D;
   check.positive("geometry.length", s.geometry.length);
@@ -166,6 +166,7 @@ std::vector<std::string> validateScene(const Scene& s) {
     }
   }
   const double limit = sceneStabilityLimit(s);
+  if (stability_limit) *stability_limit = limit;
   std::ostringstream allowed;
   allowed.precision(4);
   allowed << "dt < " << limit << " s, the stability limit of this scene for "

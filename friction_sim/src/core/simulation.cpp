@@ -41,22 +41,17 @@ GaugeProfile interpolate(const GaugeProfile& a, const GaugeProfile& b, double t)
   return out;
 }
 
-namespace {
-const Scene& validated(const Scene& scene) {
-  requireValidScene(scene);
-  return scene;
-}
-}  // namespace
+Simulation::Simulation(const Scene& scene) : Simulation(scene, requireValidScene(scene)) {}
 
-Simulation::Simulation(const Scene& scene)
-    : scene_(validated(scene)),
+Simulation::Simulation(const Scene& scene, double stability_limit)
+    : scene_(scene),
       model_(buildModel(scene_)),
       contact_(buildFrictionLaw(scene_.friction), *model_, scene_.friction.interfacial_stiffness),
       integrator_(buildIntegrator(scene_.integrator.scheme)),
       stage_(scene_.stage),
       detector_(*model_, scene_.instruments.front_fit_nodes),
       dt_(scene_.integrator.time_step),
-      stability_limit_(sceneStabilityLimit(scene_)) {
+      stability_limit_(stability_limit) {
   relaxToLoadedEquilibrium();
 }
 
