@@ -330,10 +330,11 @@ void RigSimulator::run() {
     double until = std::min(next_frame_, next_lattice_);
     if (!pending_.empty()) until = std::min(until, pending_.begin()->first);
     const long long jumps = simulation_->jumps();
-    const LoadCellReading cells_before = simulation_->loadCells();
-    const GaugeProfile gauges_before = simulation_->mayJump() && scene_.model == ModelKind::Lattice2D
-                                           ? simulation_->gaugeProfile()
-                                           : GaugeProfile{};
+    // The readings before a possible jump, to interpolate across it; not needed for a plain step.
+    const bool may_jump = simulation_->mayJump();
+    const LoadCellReading cells_before = may_jump ? simulation_->loadCells() : LoadCellReading{};
+    const GaugeProfile gauges_before =
+        may_jump && scene_.model == ModelKind::Lattice2D ? simulation_->gaugeProfile() : GaugeProfile{};
     simulation_->advance(until);
     if (simulation_->jumps() != jumps) publishAcrossJump(cells_before, gauges_before);
     publishInstruments(simulation_->eventStartedLastStep() || simulation_->eventEndedLastStep());
