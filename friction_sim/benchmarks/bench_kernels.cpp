@@ -24,16 +24,20 @@ Scene latticeScene(int nx, int nz) {
   return scene;
 }
 
-void latticeStep(benchmark::State& state) {
-  Simulation simulation(latticeScene(static_cast<int>(state.range(0)), static_cast<int>(state.range(1))));
+void latticeStep(benchmark::State& state, SpringForm form) {
+  Scene scene = latticeScene(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  scene.lattice.spring_form = form;
+  Simulation simulation(scene);
   const double nodes = static_cast<double>(state.range(0) * state.range(1));
   for (auto _ : state) simulation.step();
   state.counters["ns_per_node_step"] =
       benchmark::Counter(nodes * state.iterations() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["nodes"] = nodes;
 }
-BENCHMARK(latticeStep)->Args({57, 31})->Args({32, 32})->Args({113, 61})->Args({225, 121})->Args({449, 241})
+BENCHMARK_CAPTURE(latticeStep, geometric, SpringForm::Geometric)->Args({57, 31})->Args({32, 32})->Args({113, 61})->Args({225, 121})->Args({449, 241})
     ->Args({1001, 1001})->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(latticeStep, linearised, SpringForm::Linearised)->Args({57, 31})->Args({449, 241})
+    ->Unit(benchmark::kMicrosecond);
 
 void chainStep(benchmark::State& state) {
   Scene scene;

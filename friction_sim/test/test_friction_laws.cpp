@@ -32,10 +32,10 @@ class OneNode : public ::testing::Test {
     contact_.applyFriction(raw_, u_, force);
     return force[0];
   }
+  /// The state update after a force evaluation giving `other` and `normal` (N).
   bool update(double other, double normal) {
-    raw_.force = Vector::Constant(1, other);
-    raw_.normal_force = Vector::Constant(1, normal);
-    return contact_.updateStates(raw_, u_, v_, 0.0, 1.0);
+    net(other, normal);
+    return contact_.updateStates(u_, v_, 0.0, 1.0);
   }
 
   Chain1D block_;
@@ -111,10 +111,9 @@ TEST_F(OneNode, LosesContactAtZeroNormalForceAndRecovers) {
 
 TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
   update(3.0, 10.0);  // load ratio 0.75
-  raw_.force = Vector::Constant(1, 5.0);  // load ratio 1.25: crossed µ_s·N halfway through the step
-  raw_.normal_force = Vector::Constant(1, 10.0);
+  net(5.0, 10.0);  // load ratio 1.25: crossed µ_s·N halfway through the step
   const double dt = 1e-3, mass = 2.0;
-  ASSERT_TRUE(contact_.updateStates(raw_, u_, v_, dt, mass));
+  ASSERT_TRUE(contact_.updateStates(u_, v_, dt, mass));
   EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), 0.5);
   const double acceleration = (5.0 - kMuK * 10.0) / mass;
   EXPECT_DOUBLE_EQ(v_[0], acceleration * 0.5 * dt);
@@ -160,10 +159,10 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
   force = raw.force;
   contact.applyFriction(raw, u, force);
   EXPECT_DOUBLE_EQ(contact.frictionForce(0), -3.0);
-  EXPECT_FALSE(contact.updateStates(raw, u, v, 0.0, 1.0));
+  EXPECT_FALSE(contact.updateStates(u, v, 0.0, 1.0));
   EXPECT_DOUBLE_EQ(contact.anchorEnergy(u), 0.5 * k_t * 9e-6);
   u[0] = 5e-3;  // −5 N needed: unsticks
-  EXPECT_TRUE(contact.updateStates(raw, u, v, 0.0, 1.0));
+  EXPECT_TRUE(contact.updateStates(u, v, 0.0, 1.0));
   force = raw.force;
   contact.applyFriction(raw, u, force);
   EXPECT_DOUBLE_EQ(contact.frictionForce(0), -kMuK * 10.0);

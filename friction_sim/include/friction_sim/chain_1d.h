@@ -28,15 +28,15 @@ class Chain1D : public Model {
   double interfacePosition(int node) const override { return node * spacing_; }
   double interfaceNodeArea() const override { return area_per_block_; }
 
-  void evaluate(const Vector& u, const Vector& v, double stage_position,
-                ForceEvaluation& out) const override;
+  void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                    ForceEvaluation& out) const override;
   double elasticEnergy(const Vector& u, double stage_position) const override;
   double externalWork(const Vector&, const Vector&) const override { return 0.0; }
   SparseMatrix stiffnessMatrix() const override;
   SparseMatrix dampingMatrix() const override;
   std::vector<int> blockedDofsDuringLoading() const override;
   Vector initialBodyForce() const override;
-  void disconnectPusher() override { pusher_connected_ = false; }
+  void disconnectPusher() override;
   void connectPusher(const Vector& u) override;
   void setNormalLoad(double normal_force) override { normal_force_ = normal_force; }
   GaugeStresses gaugeStresses(const Vector&, double, const std::vector<double>&) const override {
@@ -49,7 +49,7 @@ class Chain1D : public Model {
   double nodeSpacing() const override { return spacing_; }
 
  private:
-  double drivingStiffness(int block) const;
+  void updateDrivingStiffness();
   /// N, c = 2·g·h·F_X/(L·Σξ²), the friction-induced torque's share of each block's normal force per ξ.
   double torqueCoefficient(double shear_force) const;
 
@@ -60,11 +60,14 @@ class Chain1D : public Model {
   double pushing_height_;
   double tilt_, torque_share_;
   double normal_force_;
-  std::vector<double> xi_;
+  Eigen::ArrayXd xi_;
   double xi_square_sum_;
+  Eigen::ArrayXd tilt_factor_;          ///< 1 + θξ_i per block
   std::vector<double> initial_shear_;
-  std::vector<double> pusher_offset_;
+  Vector pusher_offset_;                ///< m, u of each block when the pusher was connected
   bool pusher_connected_ = true;
+  Eigen::ArrayXd driving_stiffness_;    ///< N/m per block, 0 where the pusher does not act
+  mutable Vector bond_force_;           ///< N, work space of evaluateInto(): bond tensions, zero-padded
 };
 
 }  // namespace friction

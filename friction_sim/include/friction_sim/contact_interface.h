@@ -29,23 +29,28 @@ class ContactInterface {
   /// Sticks every node where it is, with no stored interfacial shear and slip measured from here.
   void reset(const Vector& u);
 
-  /// Adds the friction forces to `force`, which holds every other force on the degrees of freedom.
+  /// Adds the friction forces to `force`, which holds every other force on the degrees of freedom, and
+  /// records those other forces and the normal forces for the state updates.
   void applyFriction(const ForceEvaluation& raw, const Vector& u, Vector& force);
+  /// After a change of state: recomputes the friction from the recorded forces and rewrites the
+  /// interface entries of `acceleration` (m/s²) as (other force + friction)·`inverse_mass`.
+  void reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration);
 
   /// Remembers the interface at the start of a step.
   void beginStep(const Vector& u, const Vector& v);
   /// After the integrator's step: stops nodes whose velocity passed through zero at the interpolated
   /// crossing, accounts friction dissipation and slip. Returns true if any node re-stuck.
   bool finishStep(Vector& u, Vector& v, double dt);
-  /// After the last force evaluation of a step of length dt: loss and return of contact, unsticking.
-  /// A node that crossed its threshold at a fraction s of the step is given the motion it would have
-  /// made sliding for the rest of the step, (1 − s)·dt, so that slip starts on time rather than up to
-  /// a step late. Returns true if any node changed state (its friction must then be re-applied).
-  bool updateStates(const ForceEvaluation& raw, Vector& u, Vector& v, double dt, double node_mass);
+  /// After the last force evaluation of a step of length dt (and its applyFriction): loss and return of
+  /// contact, unsticking. A node that crossed its threshold at a fraction s of the step is given the
+  /// motion it would have made sliding for the rest of the step, (1 − s)·dt, so that slip starts on time
+  /// rather than up to a step late. Returns true if any node changed state (its friction must then be
+  /// re-applied).
+  bool updateStates(Vector& u, Vector& v, double dt, double node_mass);
 
   int size() const { return static_cast<int>(state_.size()); }
   ContactState state(int node) const { return state_[node]; }
-  int slidingCount() const;
+  int slidingCount() const { return sliding_count_; }
   double frictionForce(int node) const { return friction_[node]; }  ///< N, track on slider, x
   double normalForce(int node) const { return normal_[node]; }      ///< N
   double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m
@@ -64,17 +69,30 @@ class ContactInterface {
   double anchorEnergy(const Vector& u) const;
   double tangentialStiffness() const { return k_t_; }
   const FrictionLaw& law() const { return *law_; }
+  /// The interface nodes' x degrees of freedom: contiguous, dofs()[node] = dofs()[0] + node.
   const std::vector<int>& dofs() const { return dofs_; }
 
  private:
+  /// The only place a node's state changes: keeps the per-node weights of applyFriction in step.
+  void setState(int node, ContactState state);
   void stick(int node, const Vector& u);
   void startSliding(int node, int direction);
+  /// The law's coefficients for `node` after its state or slip changed.
+  void refreshCoefficients(int node);
+  /// Forgets a node's load history (it has just stuck).
+  void clearLoad(int node);
+  /// friction_ from the recorded forces: the branch-free form of the rules, so that it vectorises.
+  void computeFriction(const double* u);
 
   std::unique_ptr<FrictionLaw> law_;
   std::vector<int> dofs_;
+  int first_dof_;
   double k_t_;
   std::vector<ContactState> state_;
-  std::vector<int> direction_;       ///< ±1, sliding direction
+  int sliding_count_ = 0;
+  // Per node, in the form the friction loop needs: 1 if stuck (else 0); ±1 in the sliding direction
+  // if sliding (else 0); the law's µ_s and current sliding µ.
+  std::vector<double> stuck_weight_, sliding_sign_, static_coefficient_, sliding_coefficient_;
   std::vector<double> anchor_;       ///< m, where a stuck node is held
   std::vector<double> friction_;     ///< N
   std::vector<double> normal_;       ///< N
@@ -83,10 +101,13 @@ class ContactInterface {
   std::vector<char> just_unstuck_;
   std::vector<int> unstuck_last_step_, restuck_last_step_;
   std::vector<double> transition_fraction_;
-  std::vector<double> load_ratio_;  ///< |force needed to stick| / (µ_s·N) at the end of the last step
+  // A stuck node's load at the last update and the one before (for the crossing's interpolation): the
+  // force needed to hold it (N) and its threshold µ_s·N (N); 0 and 1 for a node that has just stuck.
+  std::vector<double> held_force_, threshold_, previous_held_force_, previous_threshold_;
   // Start-of-step copies for re-stick interpolation and dissipation.
   std::vector<double> start_u_, start_v_, start_friction_;
   std::vector<ContactState> start_state_;
+  int start_sliding_count_ = 0;
   double dissipation_ = 0.0;
 };
 

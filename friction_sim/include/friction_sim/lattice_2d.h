@@ -34,8 +34,8 @@ class Lattice2D : public Model {
   double interfacePosition(int node) const override { return node * spacing_; }
   double interfaceNodeArea() const override { return spacing_ * width_; }
 
-  void evaluate(const Vector& u, const Vector& v, double stage_position,
-                ForceEvaluation& out) const override;
+  void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                    ForceEvaluation& out) const override;
   double elasticEnergy(const Vector& u, double stage_position) const override;
   double externalWork(const Vector& u_from, const Vector& u_to) const override;
   SparseMatrix stiffnessMatrix() const override;
@@ -82,7 +82,16 @@ class Lattice2D : public Model {
   double pusher_k_per_row_;
   std::vector<double> pusher_offset_;  ///< m, u_x of each pushed node when the pusher was connected
   bool pusher_connected_ = true;
-  mutable Eigen::ArrayXd bond_x_, bond_z_, bond_power_;  ///< per-row work space of evaluate(), aligned
+  /// Work space of evaluateInto(): the bond forces (N, on the bond's lower-index node) of the current
+  /// row, along x (`horizontal`) and up to the next row (`upward`), and of the row below, zero-padded so
+  /// that the node loop needs no edge cases; and the viscous power (W) summed per column.
+  struct RowBonds {
+    std::vector<double> vertical_x, vertical_z, diagonal_x, diagonal_z, antidiagonal_x, antidiagonal_z;
+    void resize(int size);
+    void clear();
+  };
+  mutable std::vector<double> horizontal_x_, horizontal_z_, column_power_;
+  mutable RowBonds upward_, below_;
 };
 
 }  // namespace friction

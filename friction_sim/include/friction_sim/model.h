@@ -46,9 +46,15 @@ class Model {
   /// m², the interface area one node stands for (l·B or a·B), for σ = N/area and τ = f/area.
   virtual double interfaceNodeArea() const = 0;
 
-  /// Forces at displacements u and velocities v with the stage at `stage_position` (m).
-  virtual void evaluate(const Vector& u, const Vector& v, double stage_position,
-                        ForceEvaluation& out) const = 0;
+  /// Forces at displacements u and velocities v with the stage at `stage_position` (m), written to
+  /// `force` (N, per degree of freedom; resized), the rest of the evaluation to `out` (whose own `force`
+  /// is left alone). The integrators' hot loop passes its acceleration vector as `force`.
+  virtual void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                            ForceEvaluation& out) const = 0;
+  /// The same, with the forces in `out.force`.
+  void evaluate(const Vector& u, const Vector& v, double stage_position, ForceEvaluation& out) const {
+    evaluateInto(u, v, stage_position, out.force, out);
+  }
   /// J, energy stored in the springs (lattice, foundation, pusher, top load springs).
   virtual double elasticEnergy(const Vector& u, double stage_position) const = 0;
   /// J, work done by the constant external forces (the uniform top load) between two states.

@@ -104,6 +104,7 @@ class Simulation : public Dynamics {
   double stability_limit_;
   double time_ = 0.0;
   long long steps_ = 0;
+  double inverse_mass_;  ///< 1/kg, of every node
   Vector u_, v_, a_;
   double power_ = 0.0;  ///< W, viscous power at the current state
   ForceEvaluation evaluation_;  ///< the last force evaluation (friction excluded)

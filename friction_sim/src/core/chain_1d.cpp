@@ -19,15 +19,25 @@ Chain1D::Chain1D(const Scene& scene)
       tilt_(scene.chain.tilt),
       torque_share_(scene.chain.torque_share),
       normal_force_(scene.load.normal_force),
-      xi_(n_, 0.0),
-      xi_square_sum_(0.0),
+      xi_(Eigen::ArrayXd::Zero(n_)),
       initial_shear_(scene.chain.initial_shear),
-      pusher_offset_(n_, 0.0) {
+      pusher_offset_(Vector::Zero(n_)),
+      bond_force_(Vector::Zero(n_ + 1)) {
   if (n_ > 1) {
-    for (int i = 0; i < n_; ++i) {
-      xi_[i] = 2.0 * i * spacing_ / length_ - 1.0;
-      xi_square_sum_ += xi_[i] * xi_[i];
-    }
+    for (int i = 0; i < n_; ++i) xi_[i] = 2.0 * i * spacing_ / length_ - 1.0;
+  }
+  xi_square_sum_ = xi_.square().sum();
+  tilt_factor_ = 1.0 + tilt_ * xi_;
+  updateDrivingStiffness();
+}
+
+void Chain1D::updateDrivingStiffness() {
+  driving_stiffness_ = Eigen::ArrayXd::Zero(n_);
+  if (!pusher_connected_) return;
+  if (top_driving_) {
+    driving_stiffness_.setConstant(pusher_k_ / n_);
+  } else {
+    driving_stiffness_[0] = pusher_k_;
   }
 }
 
@@ -36,51 +46,37 @@ double Chain1D::torqueCoefficient(double shear_force) const {
 }
 
 std::vector<double> Chain1D::normalForces(double shear_force) const {
-  const double torque = torqueCoefficient(shear_force);
-  std::vector<double> w(n_);
-  for (int i = 0; i < n_; ++i) w[i] = normal_force_ / n_ * (1.0 + tilt_ * xi_[i]) + torque * xi_[i];
-  return w;
+  const Eigen::ArrayXd w = normal_force_ / n_ * tilt_factor_ + torqueCoefficient(shear_force) * xi_;
+  return {w.begin(), w.end()};
 }
 
-double Chain1D::drivingStiffness(int block) const {
-  if (!pusher_connected_) return 0.0;
-  if (top_driving_) return pusher_k_ / n_;
-  return block == 0 ? pusher_k_ : 0.0;
-}
-
-void Chain1D::evaluate(const Vector& u, const Vector& v, double stage_position, ForceEvaluation& out) const {
-  out.force.setZero(n_);
-  double viscous_power = 0.0;
-  for (int i = 0; i + 1 < n_; ++i) {
-    const double dv = v[i + 1] - v[i];
-    const double bond = k_ * (u[i + 1] - u[i]) + eta_ * dv;
-    viscous_power += eta_ * dv * dv;
-    out.force[i] += bond;
-    out.force[i + 1] -= bond;
-  }
+void Chain1D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                           ForceEvaluation& out) const {
+  const auto du = u.tail(n_ - 1).array() - u.head(n_ - 1).array();
+  const auto dv = v.tail(n_ - 1).array() - v.head(n_ - 1).array();
+  // bond_force_[b + 1] is the tension of the bond between blocks b and b + 1; the ends stay zero.
+  bond_force_.segment(1, n_ - 1) = k_ * du + eta_ * dv;
+  force = bond_force_.tail(n_) - bond_force_.head(n_);
+  const auto driving = driving_stiffness_ * (stage_position + pusher_offset_.array() - u.array());
   double shear = 0.0;
-  for (int i = 0; i < n_; ++i) {
-    const double stiffness = drivingStiffness(i);
-    if (stiffness == 0.0) continue;
-    const double force = stiffness * (stage_position + pusher_offset_[i] - u[i]);
-    out.force[i] += force;
-    shear += force;
+  if (top_driving_) {
+    force.array() += driving;
+    shear = driving.sum();
+  } else {
+    shear = driving_stiffness_[0] * (stage_position + pusher_offset_[0] - u[0]);
+    force[0] += shear;
   }
   out.shear_force = shear;
   out.normal_load = normal_force_;
-  out.viscous_power = viscous_power;
-  out.normal_force.resize(n_);
-  const double torque = torqueCoefficient(shear);
-  for (int i = 0; i < n_; ++i) {
-    out.normal_force[i] = std::max(0.0, normal_force_ / n_ * (1.0 + tilt_ * xi_[i]) + torque * xi_[i]);
-  }
+  out.viscous_power = eta_ * dv.square().sum();
+  out.normal_force = (normal_force_ / n_ * tilt_factor_ + torqueCoefficient(shear) * xi_).max(0.0);
 }
 
 double Chain1D::elasticEnergy(const Vector& u, double stage_position) const {
   double energy = 0.0;
   for (int i = 0; i + 1 < n_; ++i) energy += 0.5 * k_ * std::pow(u[i + 1] - u[i], 2);
   for (int i = 0; i < n_; ++i) {
-    energy += 0.5 * drivingStiffness(i) * std::pow(stage_position + pusher_offset_[i] - u[i], 2);
+    energy += 0.5 * driving_stiffness_[i] * std::pow(stage_position + pusher_offset_[i] - u[i], 2);
   }
   return energy;
 }
@@ -93,7 +89,7 @@ SparseMatrix Chain1D::stiffnessMatrix() const {
     entries.emplace_back(i, i + 1, -k_);
     entries.emplace_back(i + 1, i, -k_);
   }
-  for (int i = 0; i < n_; ++i) entries.emplace_back(i, i, drivingStiffness(i));
+  for (int i = 0; i < n_; ++i) entries.emplace_back(i, i, driving_stiffness_[i]);
   SparseMatrix matrix(n_, n_);
   matrix.setFromTriplets(entries.begin(), entries.end());
   return matrix;
@@ -125,7 +121,13 @@ Vector Chain1D::initialBodyForce() const {
 
 void Chain1D::connectPusher(const Vector& u) {
   pusher_connected_ = true;
-  for (int i = 0; i < n_; ++i) pusher_offset_[i] = u[i];
+  pusher_offset_ = u;
+  updateDrivingStiffness();
+}
+
+void Chain1D::disconnectPusher() {
+  pusher_connected_ = false;
+  updateDrivingStiffness();
 }
 
 void Chain1D::nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const {

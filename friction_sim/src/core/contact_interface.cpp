@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace friction {
 
@@ -10,9 +11,16 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
     : law_(std::move(law)), k_t_(tangential_stiffness) {
   const int n = model.interfaceNodeCount();
   for (int node = 0; node < n; ++node) dofs_.push_back(model.interfaceDof(node));
+  first_dof_ = n > 0 ? dofs_[0] : 0;
+  for (int node = 0; node < n; ++node) {
+    if (dofs_[node] != first_dof_ + node) throw std::logic_error("interface degrees of freedom must be contiguous");
+  }
   law_->resize(n);
   state_.assign(n, ContactState::Stuck);
-  direction_.assign(n, 1);
+  stuck_weight_.assign(n, 1.0);
+  sliding_sign_.assign(n, 0.0);
+  static_coefficient_.assign(n, 0.0);
+  sliding_coefficient_.assign(n, 0.0);
   anchor_.assign(n, 0.0);
   friction_.assign(n, 0.0);
   normal_.assign(n, 0.0);
@@ -20,117 +28,194 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
   slip_origin_.assign(n, 0.0);
   just_unstuck_.assign(n, 0);
   transition_fraction_.assign(n, 1.0);
-  load_ratio_.assign(n, 0.0);
+  held_force_.assign(n, 0.0);
+  threshold_.assign(n, 1.0);
+  previous_held_force_.assign(n, 0.0);
+  previous_threshold_.assign(n, 1.0);
   start_u_.assign(n, 0.0);
   start_v_.assign(n, 0.0);
   start_friction_.assign(n, 0.0);
   start_state_.assign(n, ContactState::Stuck);
+  for (int node = 0; node < n; ++node) refreshCoefficients(node);
+}
+
+void ContactInterface::setState(int node, ContactState state) {
+  sliding_count_ += (state == ContactState::Sliding) - (state_[node] == ContactState::Sliding);
+  state_[node] = state;
+  stuck_weight_[node] = state == ContactState::Stuck ? 1.0 : 0.0;
+  if (state != ContactState::Sliding) sliding_sign_[node] = 0.0;
+}
+
+void ContactInterface::refreshCoefficients(int node) {
+  static_coefficient_[node] = law_->staticCoefficient(node);
+  sliding_coefficient_[node] = law_->slidingCoefficient(node);
 }
 
 void ContactInterface::reset(const Vector& u) {
+  law_->resize(size());
   for (int node = 0; node < size(); ++node) {
-    state_[node] = ContactState::Stuck;
+    setState(node, ContactState::Stuck);
     anchor_[node] = u[dofs_[node]];
     slip_origin_[node] = u[dofs_[node]];
     just_unstuck_[node] = 0;
-    load_ratio_[node] = 0.0;
+    clearLoad(node);
+    refreshCoefficients(node);
   }
-  law_->resize(size());
   unstuck_last_step_.clear();
   restuck_last_step_.clear();
   dissipation_ = 0.0;
 }
 
-void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, Vector& force) {
-  for (int node = 0; node < size(); ++node) {
-    const int dof = dofs_[node];
-    other_force_[node] = raw.force[dof];
-    normal_[node] = raw.normal_force[node];
-    double f = 0.0;
-    switch (state_[node]) {
-      case ContactState::Stuck:
-        f = k_t_ > 0.0 ? k_t_ * (anchor_[node] - u[dof]) : -other_force_[node];
-        break;
-      case ContactState::Sliding:
-        f = -law_->slidingCoefficient(node) * normal_[node] * direction_[node];
-        break;
-      case ContactState::Detached:
-        break;
-    }
-    friction_[node] = f;
-    force[dof] += f;
+namespace {
+/// The friction rules in branch-free form, so that the loops over the nodes vectorise: a stuck node
+/// carries what holds it (weight 1), a sliding one −µ·N·sgn(v) (sign ±1); a detached node has both
+/// weights zero.
+inline double frictionOf(double stuck_weight, double holding, double sliding_coefficient, double normal,
+                         double sliding_sign) {
+  return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
+}
+/// The state update's pass over every node, branch-free so that it vectorises (restrict holds for
+/// parameters): the force needed to hold each node (the anchor spring's, or with k_T = 0 the rigid
+/// reaction) and its threshold µ_s·N. Returns how many nodes need one of the state rules: a stuck node
+/// in contact over its threshold, a node losing contact or a detached node regaining it.
+int loadPass(int n, double k_t, const double* __restrict x, const double* __restrict anchor,
+             const double* __restrict other, const double* __restrict normal, const double* __restrict mu,
+             const double* __restrict stuck, const double* __restrict sign, double* __restrict held,
+             double* __restrict threshold) {
+  const double rigid_weight = k_t > 0.0 ? 0.0 : 1.0;
+  int attention = 0;
+  for (int node = 0; node < n; ++node) {
+    held[node] = std::abs(k_t * (anchor[node] - x[node]) - rigid_weight * other[node]);
+    threshold[node] = mu[node] * normal[node];
+    // 0/1 flags as doubles, so that every lane of the loop has the same width.
+    const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
+    const double detached = 1.0 - stuck[node] - std::abs(sign[node]);
+    const double holding = stuck[node] * in_contact;
+    attention += (holding > 0.0 && held[node] > threshold[node]) || (in_contact != 1.0 - detached);
   }
+  return attention;
+}
+}  // namespace
+
+void ContactInterface::computeFriction(const double* u) {
+  const double* __restrict x = u + first_dof_;
+  const double* __restrict other = other_force_.data();
+  const double* __restrict anchor = anchor_.data();
+  const double* __restrict stuck = stuck_weight_.data();
+  const double* __restrict sign = sliding_sign_.data();
+  const double* __restrict mu = sliding_coefficient_.data();
+  const double* __restrict normal = normal_.data();
+  double* __restrict friction = friction_.data();
+  const double k_t = k_t_;
+  for (int node = 0; node < size(); ++node) {
+    const double spring = k_t * (anchor[node] - x[node]), rigid = -other[node];
+    const double holding = k_t > 0.0 ? spring : rigid;
+    friction[node] = frictionOf(stuck[node], holding, mu[node], normal[node], sign[node]);
+  }
+}
+
+void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, Vector& force) {
+  const int n = size();
+  double* __restrict f = force.data() + first_dof_;
+  std::copy_n(f, n, other_force_.data());
+  std::copy_n(raw.normal_force.data(), n, normal_.data());
+  computeFriction(u.data());
+  for (int node = 0; node < n; ++node) f[node] += friction_[node];
+}
+
+void ContactInterface::reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration) {
+  computeFriction(u.data());
+  double* a = acceleration.data() + first_dof_;
+  for (int node = 0; node < size(); ++node) a[node] = (other_force_[node] + friction_[node]) * inverse_mass;
 }
 
 void ContactInterface::beginStep(const Vector& u, const Vector& v) {
   restuck_last_step_.clear();
-  for (int node = 0; node < size(); ++node) {
-    start_u_[node] = u[dofs_[node]];
-    start_v_[node] = v[dofs_[node]];
-    start_friction_[node] = friction_[node];
-    start_state_[node] = state_[node];
-  }
+  const int n = size();
+  std::copy_n(u.data() + first_dof_, n, start_u_.data());
+  std::copy_n(v.data() + first_dof_, n, start_v_.data());
+  start_friction_ = friction_;
+  start_state_ = state_;
+  start_sliding_count_ = sliding_count_;
 }
 
 bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
   bool restuck = false;
-  for (int node = 0; node < size(); ++node) {
-    if (start_state_[node] != ContactState::Sliding) continue;
-    const int dof = dofs_[node];
-    const double v_start = start_v_[node] * direction_[node];
-    const double v_end = v[dof] * direction_[node];
-    if (!just_unstuck_[node] && v_start > 0.0 && v_end <= 0.0) {
-      // Velocity is close to linear in time over one step: stop where it crosses zero.
-      const double fraction = v_start / (v_start - v_end);
-      u[dof] = start_u_[node] + 0.5 * start_v_[node] * fraction * dt;
-      v[dof] = 0.0;
-      state_[node] = ContactState::Stuck;
-      transition_fraction_[node] = fraction;
-      load_ratio_[node] = 0.0;
-      restuck_last_step_.push_back(node);
-      if (k_t_ > 0.0) {
-        // Place the anchor so that the friction force is continuous; that spring energy has to come
-        // from somewhere in the bookkeeping, and friction is where the model puts it.
-        anchor_[node] = u[dof] + start_friction_[node] / k_t_;
-        dissipation_ -= 0.5 * start_friction_[node] * start_friction_[node] / k_t_;
-      } else {
-        anchor_[node] = u[dof];
+  if (start_sliding_count_ > 0) {
+    for (int node = 0; node < size(); ++node) {
+      if (start_state_[node] != ContactState::Sliding) continue;
+      const int dof = dofs_[node];
+      const double direction = sliding_sign_[node];
+      const double v_start = start_v_[node] * direction;
+      const double v_end = v[dof] * direction;
+      if (!just_unstuck_[node] && v_start > 0.0 && v_end <= 0.0) {
+        // Velocity is close to linear in time over one step: stop where it crosses zero.
+        const double fraction = v_start / (v_start - v_end);
+        u[dof] = start_u_[node] + 0.5 * start_v_[node] * fraction * dt;
+        v[dof] = 0.0;
+        setState(node, ContactState::Stuck);
+        transition_fraction_[node] = fraction;
+        clearLoad(node);
+        restuck_last_step_.push_back(node);
+        if (k_t_ > 0.0) {
+          // Place the anchor so that the friction force is continuous; that spring energy has to come
+          // from somewhere in the bookkeeping, and friction is where the model puts it.
+          anchor_[node] = u[dof] + start_friction_[node] / k_t_;
+          dissipation_ -= 0.5 * start_friction_[node] * start_friction_[node] / k_t_;
+        } else {
+          anchor_[node] = u[dof];
+        }
+        restuck = true;
       }
-      restuck = true;
+      const double slip = u[dof] - start_u_[node];
+      dissipation_ -= start_friction_[node] * slip;
+      law_->onSlip(node, slip);
+      refreshCoefficients(node);
     }
-    const double slip = u[dof] - start_u_[node];
-    dissipation_ -= start_friction_[node] * slip;
-    law_->onSlip(node, slip);
   }
   std::fill(just_unstuck_.begin(), just_unstuck_.end(), 0);
   return restuck;
 }
 
 void ContactInterface::stick(int node, const Vector& u) {
-  state_[node] = ContactState::Stuck;
+  setState(node, ContactState::Stuck);
   anchor_[node] = u[dofs_[node]];
-  load_ratio_[node] = 0.0;
+  clearLoad(node);
+}
+
+void ContactInterface::clearLoad(int node) {
+  held_force_[node] = 0.0;
+  threshold_[node] = 1.0;
 }
 
 void ContactInterface::startSliding(int node, int direction) {
-  state_[node] = ContactState::Sliding;
-  direction_[node] = direction;
+  setState(node, ContactState::Sliding);
+  sliding_sign_[node] = direction;
   just_unstuck_[node] = 1;
   law_->onUnstick(node);
+  refreshCoefficients(node);
   unstuck_last_step_.push_back(node);
 }
 
-bool ContactInterface::updateStates(const ForceEvaluation& raw, Vector& u, Vector& v, double dt,
-                                    double node_mass) {
+bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node_mass) {
   unstuck_last_step_.clear();
+  const int n = size();
+  // First, branch-free over every node: the load of the stuck nodes in contact, and whether any node
+  // needs one of the rules below. Usually none does, and the step ends here.
+  held_force_.swap(previous_held_force_);
+  threshold_.swap(previous_threshold_);
+  const int attention = loadPass(n, k_t_, u.data() + first_dof_, anchor_.data(), other_force_.data(),
+                                 normal_.data(), static_coefficient_.data(), stuck_weight_.data(),
+                                 sliding_sign_.data(), held_force_.data(), threshold_.data());
+  if (attention == 0) return false;
   bool changed = false;
-  for (int node = 0; node < size(); ++node) {
+  for (int node = 0; node < n; ++node) {
     const int dof = dofs_[node];
-    const double normal = raw.normal_force[node];
+    const double normal = normal_[node];
     if (normal <= 0.0) {
       if (state_[node] != ContactState::Detached) {
         if (state_[node] == ContactState::Stuck) dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
-        state_[node] = ContactState::Detached;
+        setState(node, ContactState::Detached);
         changed = true;
       }
       continue;
@@ -144,32 +229,25 @@ bool ContactInterface::updateStates(const ForceEvaluation& raw, Vector& u, Vecto
       changed = true;
       continue;
     }
-    if (state_[node] != ContactState::Stuck) continue;
-    const double needed = k_t_ > 0.0 ? k_t_ * (anchor_[node] - u[dof]) : -raw.force[dof];
-    const double ratio = std::abs(needed) / (law_->staticCoefficient(node) * normal);
-    const double previous_ratio = load_ratio_[node];
-    load_ratio_[node] = ratio;
-    if (ratio > 1.0) {
-      transition_fraction_[node] =
-          previous_ratio < 1.0 ? std::clamp((1.0 - previous_ratio) / (ratio - previous_ratio), 0.0, 1.0) : 0.0;
-      // The spring energy of an elastic anchor is released into the slip.
-      dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
-      startSliding(node, needed > 0.0 ? -1 : 1);
-      const double late = (1.0 - transition_fraction_[node]) * dt;
-      const double sliding_friction = -law_->slidingCoefficient(node) * normal * direction_[node];
-      const double acceleration = (raw.force[dof] + sliding_friction) / node_mass;
-      const double catch_up = 0.5 * acceleration * late * late;
-      u[dof] += catch_up;
-      v[dof] += acceleration * late;
-      dissipation_ -= sliding_friction * catch_up;
-      changed = true;
-    }
+    if (state_[node] != ContactState::Stuck || held_force_[node] <= threshold_[node]) continue;
+    const double needed = k_t_ > 0.0 ? k_t_ * (anchor_[node] - u[dof]) : -other_force_[node];
+    const double ratio = held_force_[node] / threshold_[node];
+    const double previous_ratio = previous_held_force_[node] / previous_threshold_[node];
+    transition_fraction_[node] =
+        previous_ratio < 1.0 ? std::clamp((1.0 - previous_ratio) / (ratio - previous_ratio), 0.0, 1.0) : 0.0;
+    // The spring energy of an elastic anchor is released into the slip.
+    dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
+    startSliding(node, needed > 0.0 ? -1 : 1);
+    const double late = (1.0 - transition_fraction_[node]) * dt;
+    const double sliding_friction = -sliding_coefficient_[node] * normal * sliding_sign_[node];
+    const double acceleration = (other_force_[node] + sliding_friction) / node_mass;
+    const double catch_up = 0.5 * acceleration * late * late;
+    u[dof] += catch_up;
+    v[dof] += acceleration * late;
+    dissipation_ -= sliding_friction * catch_up;
+    changed = true;
   }
   return changed;
-}
-
-int ContactInterface::slidingCount() const {
-  return static_cast<int>(std::count(state_.begin(), state_.end(), ContactState::Sliding));
 }
 
 double ContactInterface::anchorEnergy(const Vector& u) const {

@@ -9,8 +9,15 @@ namespace friction {
 
 double VelocityVerlet::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
                            double dt) {
-  v.noalias() += 0.5 * dt * a;
-  u.noalias() += dt * v;
+  // Kick and drift in one pass over the state.
+  double* __restrict velocity = v.data();
+  double* __restrict displacement = u.data();
+  const double* __restrict acceleration = a.data();
+  const double half_dt = 0.5 * dt;
+  for (Eigen::Index i = 0; i < u.size(); ++i) {
+    velocity[i] += half_dt * acceleration[i];
+    displacement[i] += dt * velocity[i];
+  }
   // Midpoint rule: the half-step velocity is the step's mean velocity.
   power = dynamics.acceleration(u, v, t + dt, a);
   v.noalias() += 0.5 * dt * a;

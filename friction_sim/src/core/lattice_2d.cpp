@@ -46,9 +46,11 @@ Lattice2D::Lattice2D(const Scene& scene)
                {0, 1, k_, spacing_, 0.0, 1.0},
                {1, 1, 0.5 * k_, diagonal, c, c},
                {-1, 1, 0.5 * k_, diagonal, -c, c}};
-  bond_x_.resize(nx_);
-  bond_z_.resize(nx_);
-  bond_power_.resize(nx_);
+  horizontal_x_.assign(nx_ + 2, 0.0);
+  horizontal_z_.assign(nx_ + 2, 0.0);
+  column_power_.assign(nx_ + 2, 0.0);
+  upward_.resize(nx_ + 2);
+  below_.resize(nx_ + 2);
   // Start the mattress plate where it carries F_Z with the slider undeformed.
   plate_z_ = -normal_force_ / (nx_ * mattress_k_);
 }
@@ -68,53 +70,113 @@ double Lattice2D::topSpringForce(const Vector& u, int i) const {
   return mattress_k_ * (plate_z_ - u[zDof(nodeIndex(i, nz_ - 1))]);
 }
 
-void Lattice2D::evaluate(const Vector& u, const Vector& v, double stage_position,
-                         ForceEvaluation& out) const {
-  out.force.setZero(2 * n_);
+void Lattice2D::RowBonds::resize(int size) {
+  for (auto* row : {&vertical_x, &vertical_z, &diagonal_x, &diagonal_z, &antidiagonal_x, &antidiagonal_z}) {
+    row->assign(size, 0.0);
+  }
+}
+
+void Lattice2D::RowBonds::clear() {
+  for (auto* row : {&vertical_x, &vertical_z, &diagonal_x, &diagonal_z, &antidiagonal_x, &antidiagonal_z}) {
+    std::fill(row->begin(), row->end(), 0.0);
+  }
+}
+
+namespace {
+
+struct NodeArrays {
+  const double* ux;
+  const double* uz;
+  const double* vx;
+  const double* vz;
+};
+
+/// Forces of `count` bonds of one family from nodes a0 + i to b0 + i (i < count): spring tension plus
+/// pair damping, as the force on node a; adds η|Δv|² to `power` (W) per bond.
+template <bool kGeometric>
+void bondRow(const NodeArrays& nodes, int a0, int b0, int count, double rest_x, double rest_z,
+             double rest_length, double stiffness, double eta, double* __restrict out_x,
+             double* __restrict out_z, double* __restrict power) {
+  const double* __restrict ux = nodes.ux;
+  const double* __restrict uz = nodes.uz;
+  const double* __restrict vx = nodes.vx;
+  const double* __restrict vz = nodes.vz;
+  const double ex = rest_x / rest_length, ez = rest_z / rest_length;
+  for (int i = 0; i < count; ++i) {
+    const double dux = ux[b0 + i] - ux[a0 + i], duz = uz[b0 + i] - uz[a0 + i];
+    const double dvx = vx[b0 + i] - vx[a0 + i], dvz = vz[b0 + i] - vz[a0 + i];
+    double force_x, force_z;
+    if constexpr (kGeometric) {
+      const double bond_x = rest_x + dux, bond_z = rest_z + duz;
+      const double length = std::sqrt(bond_x * bond_x + bond_z * bond_z);
+      const double tension_per_length = stiffness * (length - rest_length) / length;
+      force_x = tension_per_length * bond_x;
+      force_z = tension_per_length * bond_z;
+    } else {
+      const double tension = stiffness * (ex * dux + ez * duz);
+      force_x = ex * tension;
+      force_z = ez * tension;
+    }
+    out_x[i] = force_x + eta * dvx;
+    out_z[i] = force_z + eta * dvz;
+    power[i] += eta * (dvx * dvx + dvz * dvz);
+  }
+}
+
+}  // namespace
+
+void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                             ForceEvaluation& out) const {
+  force.resize(2 * n_);
   out.normal_force.resize(nx_);
-  double* fx = out.force.data();
-  double* fz = out.force.data() + n_;
+  double* fx = force.data();
+  double* fz = force.data() + n_;
   const double* ux = u.data();
   const double* uz = u.data() + n_;
-  const double* vx = v.data();
-  const double* vz = v.data() + n_;
-  double viscous_power = 0.0;
-  // Bonds row by row: a row of bonds of one family joins two contiguous runs of nodes, so each row is
-  // a few array expressions that Eigen evaluates with SIMD packets.
-  using ConstRow = Eigen::Map<const Eigen::ArrayXd>;
-  using Row = Eigen::Map<Eigen::ArrayXd>;
-  for (const BondFamily& family : families_) {
-    const double rest_x = family.ex * family.rest_length, rest_z = family.ez * family.rest_length;
-    const int i_begin = std::max(0, -family.di);
-    const int count = nx_ - std::max(0, family.di) - i_begin;
-    const int offset = family.dj * nx_ + family.di;
-    Row bond_x(bond_x_.data(), count), bond_z(bond_z_.data(), count), scale(bond_power_.data(), count);
-    for (int j = 0; j + family.dj < nz_; ++j) {
-      const int a0 = j * nx_ + i_begin, b0 = a0 + offset;
-      const auto dux = ConstRow(ux + b0, count) - ConstRow(ux + a0, count);
-      const auto duz = ConstRow(uz + b0, count) - ConstRow(uz + a0, count);
-      const auto dvx = ConstRow(vx + b0, count) - ConstRow(vx + a0, count);
-      const auto dvz = ConstRow(vz + b0, count) - ConstRow(vz + a0, count);
-      if (geometric_) {
-        // Tension per unit length of each bond, then its force along the current bond.
-        bond_x = rest_x + dux;
-        bond_z = rest_z + duz;
-        scale = (bond_x.square() + bond_z.square()).sqrt();
-        scale = family.stiffness * (scale - family.rest_length) / scale;
-        bond_x = scale * bond_x + eta_ * dvx;
-        bond_z = scale * bond_z + eta_ * dvz;
-      } else {
-        scale = family.stiffness * (family.ex * dux + family.ez * duz);
-        bond_x = family.ex * scale + eta_ * dvx;
-        bond_z = family.ez * scale + eta_ * dvz;
-      }
-      viscous_power += eta_ * (dvx.square() + dvz.square()).sum();
-      Row(fx + a0, count) += bond_x;
-      Row(fz + a0, count) += bond_z;
-      Row(fx + b0, count) -= bond_x;
-      Row(fz + b0, count) -= bond_z;
+  const NodeArrays nodes{ux, uz, v.data(), v.data() + n_};
+  auto bonds = geometric_ ? &bondRow<true> : &bondRow<false>;
+  // Row by row: first every bond of the row (contiguous runs of nodes, so the loops vectorise), then
+  // each node's force gathered once from its eight bonds, half of them kept from the row below.
+  // Buffer index p holds the bond whose lower-index node is at column p − 1 (p − 2 for the
+  // antidiagonal); the padding entries stay zero.
+  const BondFamily& horizontal = families_[0];
+  const BondFamily& vertical = families_[1];
+  const BondFamily& diagonal = families_[2];
+  const BondFamily& antidiagonal = families_[3];
+  auto run = [&](const BondFamily& family, int a0, int b0, int count, double* out_x, double* out_z) {
+    bonds(nodes, a0, b0, count, family.ex * family.rest_length, family.ez * family.rest_length,
+          family.rest_length, family.stiffness, eta_, out_x, out_z, column_power_.data());
+  };
+  std::fill(column_power_.begin(), column_power_.end(), 0.0);
+  below_.clear();
+  for (int j = 0; j < nz_; ++j) {
+    const int row = j * nx_, next = row + nx_;
+    run(horizontal, row, row + 1, nx_ - 1, horizontal_x_.data() + 1, horizontal_z_.data() + 1);
+    if (j + 1 < nz_) {
+      run(vertical, row, next, nx_, upward_.vertical_x.data(), upward_.vertical_z.data());
+      run(diagonal, row, next + 1, nx_ - 1, upward_.diagonal_x.data() + 1, upward_.diagonal_z.data() + 1);
+      run(antidiagonal, row + 1, next, nx_ - 1, upward_.antidiagonal_x.data() + 2,
+          upward_.antidiagonal_z.data() + 2);
+    } else {
+      upward_.clear();
     }
+    auto gather = [&](const double* __restrict h, const double* __restrict vu, const double* __restrict du,
+                      const double* __restrict au, const double* __restrict vb, const double* __restrict db,
+                      const double* __restrict ab, double* __restrict f) {
+      for (int i = 0; i < nx_; ++i) {
+        f[i] = ((h[i + 1] - h[i]) + (vu[i] - vb[i])) + ((du[i + 1] - db[i]) + (au[i + 1] - ab[i + 2]));
+      }
+    };
+    gather(horizontal_x_.data(), upward_.vertical_x.data(), upward_.diagonal_x.data(),
+           upward_.antidiagonal_x.data(), below_.vertical_x.data(), below_.diagonal_x.data(),
+           below_.antidiagonal_x.data(), fx + row);
+    gather(horizontal_z_.data(), upward_.vertical_z.data(), upward_.diagonal_z.data(),
+           upward_.antidiagonal_z.data(), below_.vertical_z.data(), below_.diagonal_z.data(),
+           below_.antidiagonal_z.data(), fz + row);
+    std::swap(upward_, below_);
   }
+  const double viscous_power =
+      Eigen::Map<const Eigen::ArrayXd>(column_power_.data(), static_cast<Eigen::Index>(column_power_.size())).sum();
   double normal_sum_top = 0.0;
   for (int i = 0; i < nx_; ++i) {
     const double normal = kf_ * std::max(0.0, -uz[i]);

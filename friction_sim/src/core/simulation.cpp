@@ -51,7 +51,8 @@ Simulation::Simulation(const Scene& scene, double stability_limit)
       stage_(scene_.stage),
       detector_(*model_, scene_.instruments.front_fit_nodes),
       dt_(scene_.integrator.time_step),
-      stability_limit_(stability_limit) {
+      stability_limit_(stability_limit),
+      inverse_mass_(1.0 / model_->nodeMass()) {
   relaxToLoadedEquilibrium();
 }
 
@@ -73,7 +74,7 @@ void Simulation::relaxToLoadedEquilibrium() {
   contact_.reset(u_);
   external_reference_u_ = u_;
   power_ = acceleration(u_, v_, 0.0, a_);
-  if (contact_.updateStates(evaluation_, u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
+  if (contact_.updateStates(u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
   initial_elastic_ = model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_);
   if (scene_.integrator.fast_forward) {
     pinned_solver_ = std::make_unique<StaticSolver>(*model_, contact_.dofs());
@@ -84,7 +85,7 @@ void Simulation::relaxToLoadedEquilibrium() {
 void Simulation::refreshAfterStaticChange() {
   power_ = acceleration(u_, v_, time_, a_);
   // Refresh every node's load ratio for the next step's threshold interpolation (no time passes).
-  if (contact_.updateStates(evaluation_, u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
+  if (contact_.updateStates(u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
 }
 
 bool Simulation::relaxToStaticEquilibrium() {
@@ -187,18 +188,13 @@ void Simulation::advance(double until) {
 }
 
 double Simulation::acceleration(const Vector& u, const Vector& v, double t, Vector& a) {
-  model_->evaluate(u, v, stage_.positionAfter(t - time_), evaluation_);
-  a = evaluation_.force;
+  model_->evaluateInto(u, v, stage_.positionAfter(t - time_), a, evaluation_);
   contact_.applyFriction(evaluation_, u, a);
-  a /= model_->nodeMass();
+  a *= inverse_mass_;
   return evaluation_.viscous_power;
 }
 
-void Simulation::reapplyFriction() {
-  a_ = evaluation_.force;
-  contact_.applyFriction(evaluation_, u_, a_);
-  a_ /= model_->nodeMass();
-}
+void Simulation::reapplyFriction() { contact_.reapplyFriction(u_, inverse_mass_, a_); }
 
 void Simulation::step() {
   contact_.beginStep(u_, v_);
@@ -210,7 +206,7 @@ void Simulation::step() {
   ++steps_;
   pusher_work_ += 0.5 * (shear_start + evaluation_.shear_force) * (stage_.position() - stage_start);
   if (contact_.finishStep(u_, v_, dt_)) power_ = acceleration(u_, v_, time_, a_);
-  if (contact_.updateStates(evaluation_, u_, v_, dt_, model_->nodeMass())) reapplyFriction();
+  if (contact_.updateStates(u_, v_, dt_, model_->nodeMass())) reapplyFriction();
   const bool was_in_event = detector_.inEvent();
   event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_,
                                  {shear_start, evaluation_.shear_force, evaluation_.normal_load});
