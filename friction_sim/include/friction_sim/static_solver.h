@@ -1,10 +1,10 @@
 // Static equilibrium of the slider with some degrees of freedom held fixed, by modified Newton: the
-// linearised stiffness of the free degrees of freedom is factored once (sparse Cholesky, LDLᵀ) and
+// linearised stiffness of the free degrees of freedom is factored once (CHOLMOD's supernodal Cholesky) and
 // corrects the residual of the full (geometric, one-sided) forces until they balance. Used for the
 // loading protocol and, with the interface pinned, for the quasi-static fast-forward.
 #pragma once
 
-#include <Eigen/SparseCholesky>
+#include <Eigen/CholmodSupport>
 #include <vector>
 
 #include "friction_sim/model.h"
@@ -31,7 +31,7 @@ class StaticSolver {
 
  private:
   std::vector<int> free_dofs_;
-  Eigen::SimplicialLDLT<SparseMatrix> factor_;
+  Eigen::CholmodSupernodalLLT<SparseMatrix> factor_;
   double tolerance_;
   bool balance_load_;
 };

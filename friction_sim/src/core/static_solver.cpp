@@ -4,6 +4,28 @@
 
 namespace friction {
 
+namespace {
+/// The lower triangle (all the factorisation reads) of the stiffness of the free degrees of freedom
+/// (`position_in_free` is −1 for a fixed one), copied column by column: the free dofs keep their
+/// order, so no triplet list is needed.
+SparseMatrix freeStiffness(const Model& model, const std::vector<int>& position_in_free, int free_count) {
+  const SparseMatrix stiffness = model.stiffnessMatrix();
+  SparseMatrix reduced(free_count, free_count);
+  reduced.reserve(stiffness.nonZeros() / 2 + free_count);
+  for (int column = 0; column < stiffness.outerSize(); ++column) {
+    const int col = position_in_free[column];
+    if (col < 0) continue;
+    reduced.startVec(col);
+    for (SparseMatrix::InnerIterator it(stiffness, column); it; ++it) {
+      const int row = position_in_free[it.row()];
+      if (row >= col) reduced.insertBack(row, col) = it.value();
+    }
+  }
+  reduced.finalize();
+  return reduced;
+}
+}  // namespace
+
 StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load)
     : balance_load_(balance_load) {
   const int n = model.dofCount();
@@ -17,16 +39,9 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
   }
   tolerance_ = 1e-14 * model.nodeSpacing() * std::max(model.gridShape()[0], 1);
   if (free_dofs_.empty()) return;
-  const SparseMatrix stiffness = model.stiffnessMatrix();
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int column = 0; column < stiffness.outerSize(); ++column) {
-    for (SparseMatrix::InnerIterator it(stiffness, column); it; ++it) {
-      const int row = position_in_free[it.row()], col = position_in_free[it.col()];
-      if (row >= 0 && col >= 0) entries.emplace_back(row, col, it.value());
-    }
-  }
-  SparseMatrix reduced(free_dofs_.size(), free_dofs_.size());
-  reduced.setFromTriplets(entries.begin(), entries.end());
+  // Built in a function of its own so that the full matrix is freed before the factorisation, the
+  // memory peak of a large lattice.
+  const SparseMatrix reduced = freeStiffness(model, position_in_free, static_cast<int>(free_dofs_.size()));
   factor_.compute(reduced);
   if (factor_.info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
 }
