@@ -50,6 +50,8 @@ class Chain1D : public Model {
 
  private:
   void updateDrivingStiffness();
+  /// N per block, w_i before clamping at zero, as an Eigen expression (no allocation in the step).
+  auto normalForceExpression(double shear_force) const;
   /// N, c = 2·g·h·F_X/(L·Σξ²), the friction-induced torque's share of each block's normal force per ξ.
   double torqueCoefficient(double shear_force) const;
 

@@ -45,8 +45,12 @@ double Chain1D::torqueCoefficient(double shear_force) const {
   return xi_square_sum_ > 0.0 ? 2.0 * torque_share_ * pushing_height_ * shear_force / (length_ * xi_square_sum_) : 0.0;
 }
 
+auto Chain1D::normalForceExpression(double shear_force) const {
+  return normal_force_ / n_ * tilt_factor_ + torqueCoefficient(shear_force) * xi_;
+}
+
 std::vector<double> Chain1D::normalForces(double shear_force) const {
-  const Eigen::ArrayXd w = normal_force_ / n_ * tilt_factor_ + torqueCoefficient(shear_force) * xi_;
+  const Eigen::ArrayXd w = normalForceExpression(shear_force);
   return {w.begin(), w.end()};
 }
 
@@ -69,7 +73,7 @@ void Chain1D::evaluateInto(const Vector& u, const Vector& v, double stage_positi
   out.shear_force = shear;
   out.normal_load = normal_force_;
   out.viscous_power = eta_ * dv.square().sum();
-  out.normal_force = (normal_force_ / n_ * tilt_factor_ + torqueCoefficient(shear) * xi_).max(0.0);
+  out.normal_force = normalForceExpression(shear).max(0.0);
 }
 
 double Chain1D::elasticEnergy(const Vector& u, double stage_position) const {

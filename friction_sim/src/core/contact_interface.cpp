@@ -70,6 +70,12 @@ namespace {
 /// The friction rules in branch-free form, so that the loops over the nodes vectorise: a stuck node
 /// carries what holds it (weight 1), a sliding one −µ·N·sgn(v) (sign ±1); a detached node has both
 /// weights zero.
+/// The force needed to hold a node where it is: its anchor spring's, or with k_T = 0 (rigid_weight 1)
+/// the reaction to every other force. Written without a branch so that the loops vectorise.
+inline double holdingForce(double k_t, double rigid_weight, double anchor, double x, double other) {
+  return k_t * (anchor - x) - rigid_weight * other;
+}
+
 inline double frictionOf(double stuck_weight, double holding, double sliding_coefficient, double normal,
                          double sliding_sign) {
   return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
@@ -85,7 +91,7 @@ int loadPass(int n, double k_t, const double* __restrict x, const double* __rest
   const double rigid_weight = k_t > 0.0 ? 0.0 : 1.0;
   int attention = 0;
   for (int node = 0; node < n; ++node) {
-    held[node] = std::abs(k_t * (anchor[node] - x[node]) - rigid_weight * other[node]);
+    held[node] = std::abs(holdingForce(k_t, rigid_weight, anchor[node], x[node], other[node]));
     threshold[node] = mu[node] * normal[node];
     // 0/1 flags as doubles, so that every lane of the loop has the same width.
     const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
@@ -106,10 +112,9 @@ void ContactInterface::computeFriction(const double* u) {
   const double* __restrict mu = sliding_coefficient_.data();
   const double* __restrict normal = normal_.data();
   double* __restrict friction = friction_.data();
-  const double k_t = k_t_;
+  const double k_t = k_t_, rigid_weight = k_t_ > 0.0 ? 0.0 : 1.0;
   for (int node = 0; node < size(); ++node) {
-    const double spring = k_t * (anchor[node] - x[node]), rigid = -other[node];
-    const double holding = k_t > 0.0 ? spring : rigid;
+    const double holding = holdingForce(k_t, rigid_weight, anchor[node], x[node], other[node]);
     friction[node] = frictionOf(stuck[node], holding, mu[node], normal[node], sign[node]);
   }
 }
