@@ -50,6 +50,16 @@ class Chain1D : public Model {
 
  private:
   void updateDrivingStiffness();
+  /// Adds the coupling `coefficient` (N/m or kg/s) of every neighbour pair to a matrix being assembled.
+  template <class Add>
+  void addNeighbourCoupling(Add&& add, double coefficient) const {
+    for (int i = 0; i + 1 < n_; ++i) {
+      add(i, i, coefficient);
+      add(i + 1, i + 1, coefficient);
+      add(i, i + 1, -coefficient);
+      add(i + 1, i, -coefficient);
+    }
+  }
   /// N per block, w_i before clamping at zero, as an Eigen expression (no allocation in the step).
   auto normalForceExpression(double shear_force) const;
   /// N, c = 2·g·h·F_X/(L·Σξ²), the friction-induced torque's share of each block's normal force per ξ.

@@ -16,6 +16,18 @@ namespace friction {
 using Vector = Eigen::VectorXd;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
+/// A `size` × `size` sparse matrix summed from the entries `fill(add)` passes to add(row, col, value),
+/// at most `entries_per_column` distinct ones per column. Sums in place in the final storage: a
+/// triplet list of a 10⁶-node lattice would take several times the matrix's memory.
+template <class Fill>
+SparseMatrix assembleSparse(int size, int entries_per_column, Fill&& fill) {
+  SparseMatrix matrix(size, size);
+  matrix.reserve(Eigen::VectorXi::Constant(size, entries_per_column));
+  fill([&matrix](int row, int col, double value) { matrix.coeffRef(row, col) += value; });
+  matrix.makeCompressed();
+  return matrix;
+}
+
 /// What one force evaluation produces; friction is not included.
 struct ForceEvaluation {
   Vector force;              ///< N, per degree of freedom

@@ -86,30 +86,14 @@ double Chain1D::elasticEnergy(const Vector& u, double stage_position) const {
 }
 
 SparseMatrix Chain1D::stiffnessMatrix() const {
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int i = 0; i + 1 < n_; ++i) {
-    entries.emplace_back(i, i, k_);
-    entries.emplace_back(i + 1, i + 1, k_);
-    entries.emplace_back(i, i + 1, -k_);
-    entries.emplace_back(i + 1, i, -k_);
-  }
-  for (int i = 0; i < n_; ++i) entries.emplace_back(i, i, driving_stiffness_[i]);
-  SparseMatrix matrix(n_, n_);
-  matrix.setFromTriplets(entries.begin(), entries.end());
-  return matrix;
+  return assembleSparse(n_, 3, [this](auto&& add) {
+    addNeighbourCoupling(add, k_);
+    for (int i = 0; i < n_; ++i) add(i, i, driving_stiffness_[i]);
+  });
 }
 
 SparseMatrix Chain1D::dampingMatrix() const {
-  std::vector<Eigen::Triplet<double>> entries;
-  for (int i = 0; i + 1 < n_; ++i) {
-    entries.emplace_back(i, i, eta_);
-    entries.emplace_back(i + 1, i + 1, eta_);
-    entries.emplace_back(i, i + 1, -eta_);
-    entries.emplace_back(i + 1, i, -eta_);
-  }
-  SparseMatrix matrix(n_, n_);
-  matrix.setFromTriplets(entries.begin(), entries.end());
-  return matrix;
+  return assembleSparse(n_, 3, [this](auto&& add) { addNeighbourCoupling(add, eta_); });
 }
 
 std::vector<int> Chain1D::blockedDofsDuringLoading() const {

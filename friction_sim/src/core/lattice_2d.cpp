@@ -254,55 +254,52 @@ double Lattice2D::externalWork(const Vector& u_from, const Vector& u_to) const {
 }
 
 SparseMatrix Lattice2D::stiffnessMatrix() const {
-  std::vector<Eigen::Triplet<double>> entries;
-  auto add = [&](int row, int col, double value) { entries.emplace_back(row, col, value); };
-  for (const BondFamily& family : families_) {
-    const double e[2] = {family.ex, family.ez};
-    forEachBond(family, [&](int a, int b) {
-      const int dofs_a[2] = {xDof(a), zDof(a)};
-      const int dofs_b[2] = {xDof(b), zDof(b)};
-      for (int p = 0; p < 2; ++p) {
-        for (int q = 0; q < 2; ++q) {
-          const double kpq = family.stiffness * e[p] * e[q];
-          add(dofs_a[p], dofs_a[q], kpq);
-          add(dofs_b[p], dofs_b[q], kpq);
-          add(dofs_a[p], dofs_b[q], -kpq);
-          add(dofs_b[p], dofs_a[q], -kpq);
+  // A node and its eight neighbours, two components each.
+  return assembleSparse(2 * n_, 18, [this](auto&& add) {
+    for (const BondFamily& family : families_) {
+      const double e[2] = {family.ex, family.ez};
+      forEachBond(family, [&](int a, int b) {
+        const int dofs_a[2] = {xDof(a), zDof(a)};
+        const int dofs_b[2] = {xDof(b), zDof(b)};
+        for (int p = 0; p < 2; ++p) {
+          for (int q = 0; q < 2; ++q) {
+            const double kpq = family.stiffness * e[p] * e[q];
+            add(dofs_a[p], dofs_a[q], kpq);
+            add(dofs_b[p], dofs_b[q], kpq);
+            add(dofs_a[p], dofs_b[q], -kpq);
+            add(dofs_b[p], dofs_a[q], -kpq);
+          }
         }
-      }
-    });
-  }
-  for (int i = 0; i < nx_; ++i) {
-    add(zDof(i), zDof(i), kf_);
-    if (mattress_) {
-      const int top = nodeIndex(i, nz_ - 1);
-      add(zDof(top), zDof(top), mattress_k_);
-      add(xDof(top), xDof(top), mattress_kx_per_node_);
+      });
     }
-  }
-  if (pusher_connected_) {
-    for (int row : pushed_rows_) add(xDof(nodeIndex(0, row)), xDof(nodeIndex(0, row)), pusher_k_per_row_);
-  }
-  SparseMatrix matrix(2 * n_, 2 * n_);
-  matrix.setFromTriplets(entries.begin(), entries.end());
-  return matrix;
+    for (int i = 0; i < nx_; ++i) {
+      add(zDof(i), zDof(i), kf_);
+      if (mattress_) {
+        const int top = nodeIndex(i, nz_ - 1);
+        add(zDof(top), zDof(top), mattress_k_);
+        add(xDof(top), xDof(top), mattress_kx_per_node_);
+      }
+    }
+    if (pusher_connected_) {
+      for (int row : pushed_rows_) add(xDof(nodeIndex(0, row)), xDof(nodeIndex(0, row)), pusher_k_per_row_);
+    }
+  });
 }
 
 SparseMatrix Lattice2D::dampingMatrix() const {
-  std::vector<Eigen::Triplet<double>> entries;
-  for (const BondFamily& family : families_) {
-    forEachBond(family, [&](int a, int b) {
-      for (int dof_shift : {0, n_}) {
-        entries.emplace_back(a + dof_shift, a + dof_shift, eta_);
-        entries.emplace_back(b + dof_shift, b + dof_shift, eta_);
-        entries.emplace_back(a + dof_shift, b + dof_shift, -eta_);
-        entries.emplace_back(b + dof_shift, a + dof_shift, -eta_);
-      }
-    });
-  }
-  SparseMatrix matrix(2 * n_, 2 * n_);
-  matrix.setFromTriplets(entries.begin(), entries.end());
-  return matrix;
+  // The pair damping acts on each component separately: a node and its eight neighbours.
+  return assembleSparse(2 * n_, 9, [this](auto&& add) {
+    for (const BondFamily& family : families_) {
+      forEachBond(family, [&](int a, int b) {
+        for (int dof_shift : {0, n_}) {
+          add(a + dof_shift, a + dof_shift, eta_);
+          add(b + dof_shift, b + dof_shift, eta_);
+          add(a + dof_shift, b + dof_shift, -eta_);
+          add(b + dof_shift, a + dof_shift, -eta_);
+        }
+      });
+    }
+  });
 }
 
 bool Lattice2D::rebalanceLoad(const Vector& u) {
