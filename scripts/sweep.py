@@ -16,7 +16,8 @@ SWEEP.yaml names a base scene, fixed overrides and the parameters to vary:
 
 Each run is an independent friction_run process. GNU parallel spreads them over the local cores
 (--jobs, default all) and, with --hosts (parallel's --sshlogin list, e.g. "2/node1,2/node2,:"), over
-other machines that have this repository built at the same path. Its job log makes a rerun skip the
+other machines that have this repository built at the same path, reached by ssh (parallel's
+PARALLEL_SSH environment variable names another ssh command). Its job log makes a rerun skip the
 runs that finished and retry the ones that failed; a failed run is reported and the others' results
 are kept. The runs' event tables are collected into DIR/events.csv with one column per varied
 parameter (DIR defaults to sweeps/<sweep file name>).
