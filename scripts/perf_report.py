@@ -118,8 +118,8 @@ def main():
         dt = {57: "2e-7", 113: "1e-7", 225: "5e-8", 449: "2.5e-8"}[nx]
         settings = {"lattice.nodes_x": nx, "lattice.nodes_z": nz, "integrator.time_step": dt,
                     "integrator.fast_forward": "true"}
-        result = run("size_%dx%d" % (nx, nz), settings, timeout=600)
-        sizes.append(result or {"settings": settings, "nodes": nx * nz, "timeout": 600})
+        result = run("size_%dx%d" % (nx, nz), settings, timeout=3600)
+        sizes.append(result or {"settings": settings, "nodes": nx * nz, "timeout": 3600})
     bench = subprocess.run([BENCH, "--benchmark_format=json", "--benchmark_min_time=0.5",
                             "--benchmark_filter=latticeStep|chainStep"],
                            check=True, capture_output=True, text=True).stdout
