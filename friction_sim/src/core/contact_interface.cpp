@@ -138,10 +138,12 @@ void ContactInterface::beginStep(const Vector& u, const Vector& v) {
   restuck_last_step_.clear();
   const int n = size();
   std::copy_n(u.data() + first_dof_, n, start_u_.data());
+  start_sliding_count_ = sliding_count_;
+  // Only finishStep() reads the rest, and only after a step that began with a node sliding.
+  if (start_sliding_count_ == 0) return;
   std::copy_n(v.data() + first_dof_, n, start_v_.data());
   start_friction_ = friction_;
   start_state_ = state_;
-  start_sliding_count_ = sliding_count_;
 }
 
 bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
