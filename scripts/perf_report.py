@@ -126,9 +126,9 @@ def main():
     bench = json.loads(bench)
     whole = [measured_run("default experiment (pmma_2d, first global event + 5 cycles)",
                           [SCENE, "--set", "stop.global_events=6"]),
-             measured_run("10^6-node lattice (1001x1001), loading + 100 steps",
-                          [SCENE, "--set", "lattice.nodes_x=1001", "--set", "lattice.nodes_z=1001",
-                           "--set", "geometry.height=0.14", "--set", "integrator.time_step=1e-8",
+             measured_run("10^6-node lattice (1401x751: pmma_2d at 0.1 mm spacing), loading + 100 steps",
+                          [SCENE, "--set", "lattice.nodes_x=1401", "--set", "lattice.nodes_z=751",
+                           "--set", "integrator.time_step=1e-8",
                            "--set", "integrator.fast_forward=false", "--set", "stop.time=1e-6"])]
     sensitivity = [measured_run("pmma_1d_side", [os.path.join(ROOT, "friction_sim/scenes/pmma_1d_side.yaml")]),
                    measured_run("pmma_1d_side, F_Z × (1 + 1e-12)",
@@ -183,6 +183,14 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
               "solve.", "", "| run | wall (s) | peak memory (MB) |", "|---|---|---|"]
     for w in whole:
         lines.append("| %s | %.2f | %.0f |" % (w["label"], w["wall"], w["peak_mb"]))
+    lines += ["", "The 10⁶-node run is over the 2 GB target because of the loading solve: the Cholesky factor of "
+              "the lattice's 2.1·10⁶ free degrees of freedom has 2.4·10⁸ non-zeros (2.2 GB with CHOLMOD's supernodal "
+              "padding) whichever ordering CHOLMOD uses (AMD, METIS and its nested dissection were measured within "
+              "5 % of each other; a 2D lattice's factor grows as n log n). The rest of the run (model, state, the "
+              "stiffness and damping matrices of the stability estimate) peaks below 1 GB. Conjugate gradients with "
+              "Eigen's incomplete Cholesky would fit in memory but needed 2100 iterations and 65 s per solve at "
+              "501 × 501 already; without a multigrid preconditioner in the allowed libraries the direct factor "
+              "stays."]
     lines += ["", "## Every mode against the reference", "",
               "Scene `pmma_2d` to its first global event. Reference: velocity Verlet, dt = 50 ns, full dynamics "
               "(%.0f s, %d steps, %d precursors, µ_s,macro = %s)." % (
