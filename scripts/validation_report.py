@@ -125,6 +125,20 @@ def front_speed_against_prestress(run_dir, mu_s=0.4, mu_k=0.17):
     return pairs
 
 
+def save_speed_figure(fig, ax, xlabel, name):
+    """Front speeds on a log axis with the model's wave speeds marked."""
+    for c, label in ((C_R, "c_R"), (C_S, "c_S"), (C_L, "c_L")):
+        ax.axhline(c, color="gray", linestyle=":")
+        ax.text(ax.get_xlim()[0], c, label, fontsize=7)
+    ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("v_c (m/s)")
+    ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(os.path.join(FIG, name), dpi=100)
+    plt.close(fig)
+
+
 def statistics_median(values):
     return float(numpy.median(values))
 
@@ -410,16 +424,7 @@ def write(data):
             points[-1][1]))
         if e["global"] != "1":
             arrest_ratios.append(points[-1][1] / statistics_median(speeds_here))
-    for c, name in ((C_R, "c_R"), (C_S, "c_S"), (C_L, "c_L")):
-        ax5a.axhline(c, color="gray", linestyle=":")
-        ax5a.text(0, c, name, fontsize=7)
-    ax5a.set_yscale("log")
-    ax5a.set_xlabel("x (mm)")
-    ax5a.set_ylabel("v_c (m/s)")
-    ax5a.legend(fontsize=6)
-    fig5a.tight_layout()
-    fig5a.savefig(os.path.join(FIG, "validation_front_profiles.png"), dpi=100)
-    plt.close(fig5a)
+    save_speed_figure(fig5a, ax5a, "x (mm)", "validation_front_profiles.png")
     L += ["Front speed profiles v_c(x) of the default run (speed from a sliding fit of first-unstick times over "
           "%d nodes):" % 5, "", "![v_c(x)](figures/validation_front_profiles.png)", "",
           "| event | x range (mm) | min v_c (m/s) | median | max | last, before arrest |", "|---|---|---|---|---|---|"]
@@ -438,16 +443,7 @@ def write(data):
         pooled += pairs
         ax5.scatter([p[0] for p in pairs], [p[1] for p in pairs], s=6, label="h = %g mm" % (float(k.split("=")[1]) * 1e3))
         correlations.append((float(k.split("=")[1]) * 1e3, len(pairs), log_correlation(pairs)))
-    for c, name in ((C_R, "c_R"), (C_S, "c_S"), (C_L, "c_L")):
-        ax5.axhline(c, color="gray", linestyle=":")
-        ax5.text(ax5.get_xlim()[0], c, name, fontsize=7)
-    ax5.set_yscale("log")
-    ax5.set_xlabel("pre-stress τ̄ = (τ/σ − µ_k)/(µ_s − µ_k) at onset")
-    ax5.set_ylabel("v_c (m/s)")
-    ax5.legend(fontsize=6)
-    fig5.tight_layout()
-    fig5.savefig(os.path.join(FIG, "validation_front_prestress.png"), dpi=100)
-    plt.close(fig5)
+    save_speed_figure(fig5, ax5, "pre-stress τ̄ = (τ/σ − µ_k)/(µ_s − µ_k) at onset", "validation_front_prestress.png")
     pooled_corr = log_correlation(pooled)
     L += ["Front speed at each node against the pre-stress that node carried when its event started, every "
           "event of the h sweep (%d node crossings):" % len(pooled), "",
