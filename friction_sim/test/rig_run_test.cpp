@@ -181,8 +181,10 @@ TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
     }
     offline.step();
   }
-  ASSERT_EQ(offline.events().size(), g_seen.events.size());
-  for (std::size_t e = 0; e < g_seen.events.size(); ++e) {
+  // The controller ends the protocol by calling the simulator's stop service when it sees the second
+  // global event; a loaded machine lets the live run step on meanwhile, so it may hold more events.
+  ASSERT_GE(g_seen.events.size(), offline.events().size());
+  for (std::size_t e = 0; e < offline.events().size(); ++e) {
     EXPECT_EQ(offline.events()[e].onset_time, g_seen.events[e].onset_time);
     EXPECT_EQ(offline.events()[e].onset_shear_force, g_seen.events[e].onset_shear_force);
     EXPECT_EQ(offline.events()[e].node_slip, g_seen.events[e].node_slip);
