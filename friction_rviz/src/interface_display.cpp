@@ -3,7 +3,6 @@
 #include <OGRE/OgreManualObject.h>
 #include <OGRE/OgreSceneManager.h>
 #include <OGRE/OgreSceneNode.h>
-#include <rviz/frame_manager.h>
 #include <rviz/properties/enum_property.h>
 #include <rviz/properties/float_property.h>
 #include <rviz/properties/int_property.h>
@@ -11,6 +10,7 @@
 #include <cmath>
 
 #include "friction_rviz/color_map.h"
+#include "frame_placement.h"
 #include "vertex_colour_material.h"
 
 namespace friction_rviz {
@@ -57,17 +57,7 @@ void InterfaceDisplay::resize() {
 void InterfaceDisplay::markDirty() { dirty_ = true; }
 
 void InterfaceDisplay::processMessage(const friction_msgs::InterfaceState::ConstPtr& msg) {
-  Ogre::Vector3 position;
-  Ogre::Quaternion orientation;
-  if (!context_->getFrameManager()->getTransform(msg->header, position, orientation)) {
-    setStatus(rviz::StatusProperty::Error, "Transform", "no transform to the fixed frame");
-    ROS_ERROR_THROTTLE(5.0, "friction_rviz InterfaceStrip: no transform from '%s' to the fixed frame",
-                       msg->header.frame_id.c_str());
-    return;
-  }
-  setStatus(rviz::StatusProperty::Ok, "Transform", "OK");
-  scene_node_->setPosition(position);
-  scene_node_->setOrientation(orientation);
+  if (!placeAtMessageFrame(*this, *context_, msg->header, *scene_node_)) return;
   const auto& values = field_->getOptionInt() == 0 ? msg->slip_velocity : msg->slip;
   if (history_.add(msg->header.stamp.toSec(), msg->position, values, msg->state)) {
     setStatus(rviz::StatusProperty::Warn, "Time", "time jumped back: history cleared");

@@ -3,7 +3,6 @@
 #include <OGRE/OgreManualObject.h>
 #include <OGRE/OgreSceneManager.h>
 #include <OGRE/OgreSceneNode.h>
-#include <rviz/frame_manager.h>
 #include <rviz/ogre_helpers/movable_text.h>
 #include <rviz/properties/bool_property.h>
 #include <rviz/properties/enum_property.h>
@@ -14,6 +13,7 @@
 #include <sstream>
 
 #include "friction_rviz/color_map.h"
+#include "frame_placement.h"
 #include "vertex_colour_material.h"
 
 namespace friction_rviz {
@@ -87,18 +87,7 @@ void SliderDisplay::processMessage(const friction_msgs::LatticeSnapshot::ConstPt
   // Time running backwards (looped playback, a reset): start over.
   if (!last_stamp_.isZero() && msg->header.stamp < last_stamp_) reset();
   last_stamp_ = msg->header.stamp;
-  Ogre::Vector3 position;
-  Ogre::Quaternion orientation;
-  if (!context_->getFrameManager()->getTransform(msg->header, position, orientation)) {
-    setStatus(rviz::StatusProperty::Error, "Transform", QString("no transform from '") +
-                                                            QString::fromStdString(msg->header.frame_id) + "'");
-    ROS_ERROR_THROTTLE(5.0, "friction_rviz Slider: no transform from '%s' to the fixed frame",
-                       msg->header.frame_id.c_str());
-    return;
-  }
-  setStatus(rviz::StatusProperty::Ok, "Transform", "OK");
-  scene_node_->setPosition(position);
-  scene_node_->setOrientation(orientation);
+  if (!placeAtMessageFrame(*this, *context_, msg->header, *scene_node_)) return;
   // Only the newest snapshot is drawn, once per rendered frame.
   latest_ = msg;
   dirty_ = true;
