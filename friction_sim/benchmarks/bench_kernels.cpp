@@ -45,9 +45,9 @@ void chainStep(benchmark::State& state) {
   scene.chain.blocks = static_cast<int>(state.range(0));
   scene.stage.program = {StageSegment{StageMode::Hold, 0.0}};
   scene.stop.time = 1e9;
-  scene.integrator.time_step = 1e-20;
-  scene.integrator.time_step = 0.5 * sceneStabilityLimit(scene);
-  Simulation simulation(scene);
+  const double stability_limit = sceneStabilityLimit(scene);
+  scene.integrator.time_step = 0.5 * stability_limit;
+  Simulation simulation(scene, stability_limit);
   for (auto _ : state) simulation.step();
   state.counters["ns_per_block_step"] = benchmark::Counter(
       static_cast<double>(state.range(0)) * state.iterations() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);

@@ -106,8 +106,6 @@ class ContactInterface {
   std::vector<double> held_force_, threshold_, previous_held_force_, previous_threshold_;
   // Start-of-step copies for re-stick interpolation and dissipation.
   std::vector<double> start_u_, start_v_, start_friction_;
-  std::vector<ContactState> start_state_;
-  int start_sliding_count_ = 0;
   double dissipation_ = 0.0;
 };
 

@@ -20,15 +20,18 @@ class SceneError : public ConfigError {
 };
 
 /// Parses a scene from YAML text; fields absent from the text keep the defaults of `base`.
-/// Throws SceneError listing every problem (parse and validation).
-Scene parseScene(const std::string& yaml_text, const Scene& base = Scene{});
+/// Throws SceneError listing every problem (parse and validation). The validation computes the scene's
+/// stability limit (s); given `stability_limit`, it is kept there for Simulation(scene, limit), so that
+/// a large lattice's spectrum is not estimated twice.
+Scene parseScene(const std::string& yaml_text, const Scene& base = Scene{}, double* stability_limit = nullptr);
 
 /// Reads and parses a scene file (see parseScene).
-Scene loadScene(const std::string& path);
+Scene loadScene(const std::string& path, double* stability_limit = nullptr);
 
 /// The scene with fields replaced: each override is a dotted key ("pusher.height") and a YAML value
-/// ("0.01"). The result is parsed and validated like a file. Throws SceneError.
-Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides);
+/// ("0.01"). The result is parsed and validated like a file (see parseScene). Throws SceneError.
+Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides,
+                    double* stability_limit = nullptr);
 
 /// Every problem of a scene (empty when valid): ranges, cross-field constraints, dt stability. When
 /// the model's own fields are valid and `stability_limit` is given, it receives the scene's stability

@@ -24,6 +24,8 @@ class Simulation : public Dynamics {
  public:
   /// Throws SceneError if the scene is invalid.
   explicit Simulation(const Scene& scene);
+  /// For a scene already validated: `stability_limit` (s) is the limit its validation computed.
+  Simulation(const Scene& scene, double stability_limit);
 
   /// Advances by one time step.
   void step();
@@ -81,8 +83,6 @@ class Simulation : public Dynamics {
   double acceleration(const Vector& u, const Vector& v, double t, Vector& a) override;
 
  private:
-  /// `stability_limit` (s) comes from the validation, which has computed it already.
-  Simulation(const Scene& scene, double stability_limit);
   void relaxToLoadedEquilibrium();
   /// With the interface pinned where it sticks: the static equilibrium, if it holds every node within
   /// its threshold and in contact. Applies it (the energy of the ring-down it skips is counted as
@@ -107,7 +107,8 @@ class Simulation : public Dynamics {
   double inverse_mass_;  ///< 1/kg, of every node
   Vector u_, v_, a_;
   double power_ = 0.0;  ///< W, viscous power at the current state
-  ForceEvaluation evaluation_;  ///< the last force evaluation (friction excluded)
+  /// The last force evaluation (friction excluded); its `force` stays empty, the forces go to a_.
+  ForceEvaluation evaluation_;
   bool event_ended_ = false;
   bool event_started_ = false;
   std::string stop_reason_;

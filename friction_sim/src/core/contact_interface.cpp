@@ -35,7 +35,6 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
   start_u_.assign(n, 0.0);
   start_v_.assign(n, 0.0);
   start_friction_.assign(n, 0.0);
-  start_state_.assign(n, ContactState::Stuck);
   for (int node = 0; node < n; ++node) refreshCoefficients(node);
 }
 
@@ -67,15 +66,15 @@ void ContactInterface::reset(const Vector& u) {
 }
 
 namespace {
-/// The friction rules in branch-free form, so that the loops over the nodes vectorise: a stuck node
-/// carries what holds it (weight 1), a sliding one −µ·N·sgn(v) (sign ±1); a detached node has both
-/// weights zero.
 /// The force needed to hold a node where it is: its anchor spring's, or with k_T = 0 (rigid_weight 1)
-/// the reaction to every other force. Written without a branch so that the loops vectorise.
+/// the reaction to every other force.
 inline double holdingForce(double k_t, double rigid_weight, double anchor, double x, double other) {
   return k_t * (anchor - x) - rigid_weight * other;
 }
 
+/// The friction rules in branch-free form, so that the loops over the nodes vectorise: a stuck node
+/// carries what holds it (weight 1), a sliding one −µ·N·sgn(v) (sign ±1); a detached node has both
+/// weights zero.
 inline double frictionOf(double stuck_weight, double holding, double sliding_coefficient, double normal,
                          double sliding_sign) {
   return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
@@ -138,19 +137,19 @@ void ContactInterface::beginStep(const Vector& u, const Vector& v) {
   restuck_last_step_.clear();
   const int n = size();
   std::copy_n(u.data() + first_dof_, n, start_u_.data());
-  start_sliding_count_ = sliding_count_;
-  // Only finishStep() reads the rest, and only after a step that began with a node sliding.
-  if (start_sliding_count_ == 0) return;
+  // Only finishStep() reads the rest, and only after a step that began with a node sliding. No state
+  // changes between the two, so the states it reads are still those of the step's start.
+  if (sliding_count_ == 0) return;
   std::copy_n(v.data() + first_dof_, n, start_v_.data());
   start_friction_ = friction_;
-  start_state_ = state_;
 }
 
 bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
   bool restuck = false;
-  if (start_sliding_count_ > 0) {
+  if (sliding_count_ > 0) {
     for (int node = 0; node < size(); ++node) {
-      if (start_state_[node] != ContactState::Sliding) continue;
+      // Re-sticking below changes only this node, so state_ still holds the step's start here.
+      if (state_[node] != ContactState::Sliding) continue;
       const int dof = dofs_[node];
       const double direction = sliding_sign_[node];
       const double v_start = start_v_[node] * direction;

@@ -207,7 +207,7 @@ std::string readTextFile(const std::string& path, std::vector<std::string>& prob
   return text.str();
 }
 
-Scene parseScene(const std::string& yaml_text, const Scene& base) {
+Scene parseScene(const std::string& yaml_text, const Scene& base, double* stability_limit) {
   Scene scene = base;
   std::vector<std::string> problems;
   YAML::Node root;
@@ -220,19 +220,20 @@ Scene parseScene(const std::string& yaml_text, const Scene& base) {
   visitScene(scene, reader);
   reader.rejectUnknownKeys();
   // Validate even after parse problems so that one refusal lists everything wrong with the file.
-  for (auto& problem : validateScene(scene)) problems.push_back(std::move(problem));
+  for (auto& problem : validateScene(scene, stability_limit)) problems.push_back(std::move(problem));
   if (!problems.empty()) throw SceneError(problems);
   return scene;
 }
 
-Scene loadScene(const std::string& path) {
+Scene loadScene(const std::string& path, double* stability_limit) {
   std::vector<std::string> problems;
   const std::string text = readTextFile(path, problems);
   if (!problems.empty()) throw SceneError(problems);
-  return parseScene(text);
+  return parseScene(text, Scene{}, stability_limit);
 }
 
-Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides) {
+Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides,
+                    double* stability_limit) {
   YAML::Node root(YAML::NodeType::Map);
   std::vector<std::string> problems;
   for (const auto& [key, value] : overrides) {
@@ -255,7 +256,7 @@ Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, 
     }
   }
   if (!problems.empty()) throw SceneError(problems);
-  return parseScene(YAML::Dump(root), base);
+  return parseScene(YAML::Dump(root), base, stability_limit);
 }
 
 std::string sceneToYaml(const Scene& scene) {

@@ -114,8 +114,8 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
     : nh_(std::move(nh)), options_(std::move(options)) {
   std::vector<std::string> problems;
   const auto overrides = parseOverrides(options_.overrides, problems);
-  scene_ = loadScene(options_.scene_path);
-  if (!overrides.empty()) scene_ = overrideScene(scene_, overrides);
+  scene_ = loadScene(options_.scene_path, &stability_limit_);
+  if (!overrides.empty()) scene_ = overrideScene(scene_, overrides, &stability_limit_);
   for (const std::string& warning : sceneWarnings(scene_)) ROS_WARN_STREAM("scene: " << warning);
   wave_speeds_ = waveSpeedsOf(scene_);
   paused_ = options_.start_paused;
@@ -132,7 +132,7 @@ RigSimulator::~RigSimulator() {
 }
 
 void RigSimulator::startSimulation() {
-  simulation_ = std::make_unique<Simulation>(scene_);
+  simulation_ = std::make_unique<Simulation>(scene_, stability_limit_);
   interface_positions_.clear();
   for (int node = 0; node < simulation_->model().interfaceNodeCount(); ++node) {
     interface_positions_.push_back(simulation_->model().interfacePosition(node));

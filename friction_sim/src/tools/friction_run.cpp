@@ -41,14 +41,15 @@ int run(int argc, char** argv) {
       return usage();
     }
   }
-  friction::Scene scene = friction::loadScene(scene_path);
-  if (!overrides.empty()) scene = friction::overrideScene(scene, overrides);
+  double stability_limit = 0.0;
+  friction::Scene scene = friction::loadScene(scene_path, &stability_limit);
+  if (!overrides.empty()) scene = friction::overrideScene(scene, overrides, &stability_limit);
   for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
   if (out_dir.empty()) out_dir = "results/" + scene.name;
   std::filesystem::create_directories(out_dir);
 
   const auto start = std::chrono::steady_clock::now();
-  friction::Simulation simulation(scene);
+  friction::Simulation simulation(scene, stability_limit);
   std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
   std::ofstream stresses_csv(out_dir + "/stresses.csv");
   stresses_csv << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
@@ -68,8 +69,8 @@ int run(int argc, char** argv) {
   };
   const double sample_interval = 1.0 / scene.instruments.loading_curve_rate;
   double next_sample = sample_interval;
+  friction::LoadCellReading before = loading.front();
   while (!simulation.finished()) {
-    const friction::LoadCellReading before = simulation.loadCells();
     simulation.advance(scene.stop.time);
     const friction::LoadCellReading after = simulation.loadCells();
     for (; next_sample <= after.time; next_sample += sample_interval) {
@@ -84,6 +85,7 @@ int run(int argc, char** argv) {
                 << ", L_p/L = " << event.rupture_length / scene.geometry.length
                 << (event.global ? " (global)" : "") << std::endl;
     }
+    before = after;
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (scene.integrator.fast_forward) {

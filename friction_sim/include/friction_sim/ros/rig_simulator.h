@@ -118,6 +118,7 @@ class RigSimulator {
   ros::NodeHandle nh_;
   SimulatorOptions options_;
   Scene scene_;
+  double stability_limit_ = 0.0;  ///< s, of scene_, from its validation
   std::unique_ptr<Simulation> simulation_;
   std::vector<double> interface_positions_;
   WaveSpeeds wave_speeds_;
