@@ -51,6 +51,11 @@ class ContactInterface {
   int size() const { return static_cast<int>(state_.size()); }
   ContactState state(int node) const { return state_[node]; }
   int slidingCount() const { return sliding_count_; }
+  /// True when every node is stuck (none sliding, none detached).
+  bool allStuck() const;
+  /// Whether an equilibrium found with the interface pinned keeps every node stuck: each in contact and
+  /// its pin's reaction, −trial.force at its dof, within µ_s·N.
+  bool holdsPinned(const ForceEvaluation& trial) const;
   double frictionForce(int node) const { return friction_[node]; }  ///< N, track on slider, x
   double normalForce(int node) const { return normal_[node]; }      ///< N
   double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m

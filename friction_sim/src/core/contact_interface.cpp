@@ -236,7 +236,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
       continue;
     }
     if (state_[node] != ContactState::Stuck || held_force_[node] <= threshold_[node]) continue;
-    const double needed = k_t_ > 0.0 ? k_t_ * (anchor_[node] - u[dof]) : -other_force_[node];
+    const double needed = holdingForce(k_t_, k_t_ > 0.0 ? 0.0 : 1.0, anchor_[node], u[dof], other_force_[node]);
     const double ratio = held_force_[node] / threshold_[node];
     const double previous_ratio = previous_held_force_[node] / previous_threshold_[node];
     transition_fraction_[node] =
@@ -254,6 +254,18 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     changed = true;
   }
   return changed;
+}
+
+bool ContactInterface::allStuck() const {
+  return std::all_of(state_.begin(), state_.end(), [](ContactState s) { return s == ContactState::Stuck; });
+}
+
+bool ContactInterface::holdsPinned(const ForceEvaluation& trial) const {
+  for (int node = 0; node < size(); ++node) {
+    const double normal = trial.normal_force[node];
+    if (normal <= 0.0 || std::abs(trial.force[dofs_[node]]) > static_coefficient_[node] * normal) return false;
+  }
+  return true;
 }
 
 double ContactInterface::anchorEnergy(const Vector& u) const {

@@ -60,18 +60,12 @@ void Simulation::refreshAfterStaticChange() {
 }
 
 bool Simulation::relaxToStaticEquilibrium() {
-  for (int node = 0; node < contact_.size(); ++node) {
-    if (contact_.state(node) != ContactState::Stuck) return false;
-  }
+  if (!contact_.allStuck()) return false;
   Vector relaxed = u_;
   pinned_solver_->solve(*model_, relaxed, stage_.position());
   ForceEvaluation check;
   model_->evaluate(relaxed, Vector::Zero(u_.size()), stage_.position(), check);
-  for (int node = 0; node < contact_.size(); ++node) {
-    const double normal = check.normal_force[node];
-    const double needed = std::abs(check.force[contact_.dofs()[node]]);
-    if (normal <= 0.0 || needed > contact_.law().staticCoefficient(node) * normal) return false;
-  }
+  if (!contact_.holdsPinned(check)) return false;
   // What the ring-down would have dissipated: the drop in potential energy plus the kinetic energy.
   auto potential = [&](const Vector& u) {
     return model_->elasticEnergy(u, stage_.position()) - model_->externalWork(external_reference_u_, u);
