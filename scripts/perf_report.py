@@ -14,7 +14,6 @@ import math
 import os
 import platform
 import re
-import resource
 import subprocess
 import sys
 import time
@@ -24,8 +23,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-RUN = os.path.join(ROOT, ".build/devel/lib/friction_sim/friction_run")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from sweep import ROOT, RUNNER as RUN, first_global, precursors  # noqa: E402
+
 BENCH = os.path.join(ROOT, ".build/devel/lib/friction_sim/bench_kernels")
 SCENE = os.path.join(ROOT, "friction_sim/scenes/pmma_2d.yaml")
 OUT = os.path.join(ROOT, ".build/perf")
@@ -37,18 +37,18 @@ def run(name, settings, timeout=None):
     args = [RUN, SCENE, "--out", out]
     for key, value in settings.items():
         args += ["--set", "%s=%s" % (key, value)]
-    text = ""
     marker = os.path.join(out, "timed_out")
     if os.path.exists(marker):
         return None
     if not os.path.exists(os.path.join(out, "summary.txt")):
         try:
-            text = subprocess.run(args, check=True, capture_output=True, text=True, timeout=timeout).stdout
+            subprocess.run(args, check=True, capture_output=True, text=True, timeout=timeout)
         except subprocess.TimeoutExpired:
             os.makedirs(out, exist_ok=True)
             open(marker, "w").close()
             return None
-    summary = open(os.path.join(out, "summary.txt")).read()
+    with open(os.path.join(out, "summary.txt")) as handle:
+        summary = handle.read()
     wall = float(re.search(r"wall time ([0-9.e+-]+) s", summary).group(1))
     steps = int(re.search(r"in ([0-9]+) steps", summary).group(1))
     residual = float(re.search(r"residual \(relative\): ([-0-9.e+na]+)", summary).group(1))
@@ -58,34 +58,20 @@ def run(name, settings, timeout=None):
     if "lattice.nodes_x" in settings:
         nodes = int(settings["lattice.nodes_x"]) * int(settings["lattice.nodes_z"])
     return {"name": name, "settings": settings, "wall": wall, "steps": steps, "residual": residual,
-            "events": events, "nodes": nodes, "stdout": text}
-
-
-def precursors(result):
-    out = []
-    for event in result["events"]:
-        if event["global"] == "1":
-            break
-        out.append(event)
-    return out
-
-
-def first_global(result):
-    return next((e for e in result["events"] if e["global"] == "1"), None)
+            "events": events, "nodes": nodes}
 
 
 def errors(result, reference):
-    mine, ref = precursors(result), precursors(reference)
-    n = min(len(mine), len(ref))
+    mine, ref = precursors(result["events"]), precursors(reference["events"])
     shear = max([abs(float(a["onset_shear_force_N"]) / float(b["onset_shear_force_N"]) - 1) for a, b in zip(mine, ref)]
                 + [0.0])
     length = max([abs(float(a["rupture_length_m"]) - float(b["rupture_length_m"])) for a, b in zip(mine, ref)] + [0.0])
-    g, gr = first_global(result), first_global(reference)
+    g, gr = first_global(result["events"]), first_global(reference["events"])
     macro = abs(float(g["shear_ratio"]) / float(gr["shear_ratio"]) - 1) if g and gr else math.nan
     speed = (abs(float(g["median_front_speed_m_s"]) / float(gr["median_front_speed_m_s"]) - 1)
              if g and gr else math.nan)
     return {"precursors": len(mine), "precursor_difference": len(mine) - len(ref), "shear": shear,
-            "length_mm": length * 1e3, "compared": n, "macro": macro, "front_speed": speed}
+            "length_mm": length * 1e3, "macro": macro, "front_speed": speed}
 
 
 def main():
@@ -147,9 +133,9 @@ def measured_run(label, args):
     peak_kb = int(subprocess.run([sys.executable, "-c", probe, RUN] + args + ["--out", out], check=True,
                                  capture_output=True, text=True).stdout.split()[-1])
     wall = time.monotonic() - start
-    summary = open(os.path.join(out, "summary.txt")).read()
-    return {"label": label, "wall": wall, "peak_mb": peak_kb / 1024.0, "summary": summary,
-            "events": list(csv.DictReader(open(os.path.join(out, "events.csv"))))}
+    with open(os.path.join(out, "summary.txt")) as handle:
+        summary = handle.read()
+    return {"label": label, "wall": wall, "peak_mb": peak_kb / 1024.0, "summary": summary}
 
 
 def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
@@ -195,8 +181,8 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
     lines += ["", "## Every mode against the reference", "",
               "Scene `pmma_2d` to its first global event. Reference: velocity Verlet, dt = 50 ns, full dynamics "
               "(%.0f s, %d steps, %d precursors, µ_s,macro = %s)." % (
-                  reference["wall"], reference["steps"], len(precursors(reference)),
-                  first_global(reference)["shear_ratio"] if first_global(reference) else "none"), "",
+                  reference["wall"], reference["steps"], len(precursors(reference["events"])),
+                  first_global(reference["events"])["shear_ratio"] if first_global(reference["events"]) else "none"), "",
               "| mode | wall (s) | steps | wall per node-step (ns) | precursors (Δ) | max ΔF_X/F_X at onsets | max ΔL_p (mm) | "
               "Δµ_s,macro | Δ front speed | energy residual |", "|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
@@ -218,16 +204,15 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
               "![Pareto front](figures/pareto.png)", "",
               "## Fast-forward", "",
               "| stage speed | wall with fast-forward (s) | steps | first global event at (s) |", "|---|---|---|---|"]
-    ff = next(r for r in results if r["label"] == "velocity_verlet dt=2e-7 ff=true")
     full = next((r for r in results if r["label"] == "velocity_verlet dt=2e-7 ff=false"), None)
-    lines.append("| 0.4 mm/s | %.2f | %d | %s |" % (ff["wall"], ff["steps"], first_global(ff)["onset_time_s"]))
-    g = first_global(slow)
+    lines.append("| 0.4 mm/s | %.2f | %d | %s |" % (default["wall"], default["steps"], first_global(default["events"])["onset_time_s"]))
+    g = first_global(slow["events"])
     lines.append("| 10 µm/s | %.2f | %d | %s |" % (slow["wall"], slow["steps"], g["onset_time_s"] if g else "no global event in 100 s"))
     if full:
         lines += ["", "Full dynamics at 0.4 mm/s: %.1f s (%d steps): fast-forward is %.0f× faster. At 10 µm/s full "
                   "dynamics would need 40× the steps (%.2g steps, about %.0f s at the measured step cost; not run), "
                   "fast-forward about the same as at 0.4 mm/s." % (
-                      full["wall"], full["steps"], full["wall"] / ff["wall"], 40 * full["steps"], 40 * full["wall"])]
+                      full["wall"], full["steps"], full["wall"] / default["wall"], 40 * full["steps"], 40 * full["wall"])]
     lines += ["", "## Lattice size (fast-forward on, dt scaled with the spacing)", "",
               "| lattice | nodes | dt (s) | wall (s) | steps | wall per node-step (ns) |", "|---|---|---|---|---|---|"]
     for s in sizes:

@@ -87,6 +87,21 @@ def run(path, jobs=None, hosts=None, out=None):
     return collect(spec, points, out)
 
 
+def precursors(events):
+    """The events of one run's table before its first global slip event."""
+    out = []
+    for event in events:
+        if event["global"] == "1":
+            break
+        out.append(event)
+    return out
+
+
+def first_global(events):
+    """The first global slip event of one run's table, or None."""
+    return next((event for event in events if event["global"] == "1"), None)
+
+
 def collect(spec, points, out):
     rows, failed = [], []
     for point in points:

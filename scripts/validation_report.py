@@ -21,6 +21,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sweep  # noqa: E402
+from sweep import first_global, precursors  # noqa: E402
 
 ROOT = sweep.ROOT
 FIG = os.path.join(ROOT, "docs/figures")
@@ -35,19 +36,6 @@ def runs_of(rows):
     for row in rows:
         out.setdefault(row["run"], []).append(row)
     return out
-
-
-def precursors(events):
-    out = []
-    for e in events:
-        if e["global"] == "1":
-            break
-        out.append(e)
-    return out
-
-
-def first_global(events):
-    return next((e for e in events if e["global"] == "1"), None)
 
 
 def f(row, key):
@@ -143,19 +131,26 @@ def save_speed_figure(fig, ax, xlabel, name):
     plt.close(fig)
 
 
-def statistics_median(values):
-    return float(numpy.median(values))
-
-
 def log_correlation(pairs):
     """Pearson correlation of log v_c with τ̄."""
     return float(numpy.corrcoef([p[0] for p in pairs], numpy.log([p[1] for p in pairs]))[0, 1])
 
 
+def by_value(runs):
+    """(run name, events) of a sweep with one varied parameter, in the order of its value."""
+    return sorted(runs.items(), key=lambda kv: float(kv[0].split("=")[1]))
+
+
+def macro_cell(events):
+    """µ_s,macro of a run, or "none" without a global event."""
+    g = first_global(events)
+    return "%.4f" % f(g, "shear_ratio") if g else "none"
+
+
 def global_row(label, events):
     """A table row: label, precursors before the first global event, µ_s,macro, its median front speed."""
     g = first_global(events)
-    return "| %s | %d | %s | %s |" % (label, len(precursors(events)), "%.4f" % f(g, "shear_ratio") if g else "none",
+    return "| %s | %d | %s | %s |" % (label, len(precursors(events)), macro_cell(events),
                                       "%.0f" % f(g, "median_front_speed_m_s") if g else "-")
 
 
@@ -227,9 +222,9 @@ def write(data):
     speeds = data["stage_speed"]
     heights = data["pushing_height"]
     fig2 = figure("validation_lp_fx.png", [
-        ("F_Z (N)", [(k.split("=")[1], v) for k, v in sorted(loads.items(), key=lambda kv: float(kv[0].split("=")[1]))]),
+        ("F_Z (N)", [(k.split("=")[1], v) for k, v in by_value(loads)]),
         ("stage speed V", [(k.split("speed")[1][:7], v) for k, v in sorted(speeds.items())]),
-        ("pushing height h (m)", [(k.split("=")[1], v) for k, v in sorted(heights.items(), key=lambda kv: float(kv[0].split("=")[1]))
+        ("pushing height h (m)", [(k.split("=")[1], v) for k, v in by_value(heights)
                                   if float(k.split("=")[1]) in (0.0, 0.005, 0.01, 0.02)])])
     spread = []
     keyed = {k: [(f(e, "shear_ratio"), f(e, "length_ratio")) for e in precursors(v)] for k, v in loads.items()}
@@ -247,8 +242,7 @@ def write(data):
           "that needs a load-dependent ingredient (rate-and-state or a real-contact-area law), not in the model." % (max(spread) if spread else 0), ""]
     speed_rows = []
     for k, v in sorted(speeds.items()):
-        gg = first_global(v)
-        speed_rows.append("| %s | %d | %s |" % (k.split("speed")[1][:7], len(precursors(v)), "%.4f" % f(gg, "shear_ratio") if gg else "none"))
+        speed_rows.append("| %s | %d | %s |" % (k.split("speed")[1][:7], len(precursors(v)), macro_cell(v)))
     L += ["| V (m/s) | precursors | µ_s,macro |", "|---|---|---|"] + speed_rows
     L += ["", "*Agreement*: independent of V, yes (same precursors; µ_s,macro within 0.3 % over a factor 40 in "
           "V). Independent of h, no: h changes the curve and the number of precursors (item 3). Collapse with "
@@ -265,10 +259,11 @@ def write(data):
           "ΔBIC over one line | ΔBIC over a parabola |", "|---|---|---|---|---|---|---|---|---|"]
     kinks = {}
     for label, events in kink_sets:
-        kink = fit_kink([(f(e, "shear_ratio"), f(e, "length_ratio")) for e in front(events)])
+        points = [(f(e, "shear_ratio"), f(e, "length_ratio")) for e in front(events)]
+        kink = fit_kink(points)
         kinks[label] = kink
         if kink is None:
-            L.append("| %s | %d | fewer than 6 points | | | | | | |" % (label, len(front(events))))
+            L.append("| %s | %d | fewer than 6 points | | | | | | |" % (label, len(points)))
             continue
         L.append("| %s | %d | %.2e | %.2e | %.4f | %.2f | %.1f / %.1f | %.1f | %.1f |" % (
             label, kink["n"], kink["line_rss"], kink["kink_rss"], kink["breakpoint"], kink["length_at_kink"],
@@ -293,7 +288,7 @@ def write(data):
     # 3. h
     fig3, ax = plt.subplots(1, 2, figsize=(8.4, 3.2))
     hs, counts, macros, single = [], [], [], []
-    for k, v in sorted(heights.items(), key=lambda kv: float(kv[0].split("=")[1])):
+    for k, v in by_value(heights):
         gg = first_global(v)
         hs.append(float(k.split("=")[1]) * 1e3)
         counts.append(len(precursors(v)))
@@ -318,7 +313,7 @@ def write(data):
     # The interface profiles at the first event's onset, which set where and how far the first fronts run.
     fig3b, ax3b = plt.subplots(1, 2, figsize=(8.4, 3.2))
     onset_profiles = {}
-    for k in sorted(heights, key=lambda k: float(k.split("=")[1])):
+    for k, _ in by_value(heights):
         h = float(k.split("=")[1]) * 1e3
         if h not in (0.0, 5.0, 10.0, 20.0, 75.0):
             continue
@@ -341,11 +336,12 @@ def write(data):
     L += ["", "![interface profiles against h](figures/validation_height_profiles.png)", "",
           "| h (mm) | σ at the trailing edge / mean σ | σ at the leading edge / mean σ | interface length with τ/σ > µ_k at onset (mm, anywhere) |",
           "|---|---|---|---|"]
+    edges = {}  # h (mm): σ at the trailing and leading edge / mean σ, length with τ/σ > µ_k (mm)
     for h, (x, sigma, ratio) in onset_profiles.items():
         mean = sum(sigma) / len(sigma)
         loaded = sum(1 for r in ratio if r > 0.17) * (x[1] - x[0])
         L.append("| %g | %.2f | %.2f | %.1f |" % (h, sigma[0] / mean, sigma[-1] / mean, loaded))
-        onset_profiles[h] = (sigma[0] / mean, sigma[-1] / mean, loaded)
+        edges[h] = (sigma[0] / mean, sigma[-1] / mean, loaded)
     L += ["", "*Agreement*: qualitative yes — both change strongly with h (%d to %d precursors, µ_s,macro %.3f "
           "to %.3f over h = 0–75 mm): the count falls as h rises from 0 to 20 mm, and pushing at the top corner "
           "gives many precursors and the highest µ_s,macro." % (min(counts), max(counts), min(macros), max(macros)),
@@ -358,8 +354,8 @@ def write(data):
           "corner the trailing edge keeps only %.2f of the mean σ; the loading there is concentrated in a few "
           "nodes, which slip one by one (the single-node slips of the table) before a front can run, and the "
           "heavily loaded leading edge holds the slider to the highest µ_s,macro." % (
-              onset_profiles[0.0][0], onset_profiles[20.0][0], onset_profiles[0.0][1], onset_profiles[20.0][1],
-              onset_profiles[0.0][2], onset_profiles[20.0][2], counts[hs.index(20.0)], onset_profiles[75.0][0]), ""]
+              edges[0.0][0], edges[20.0][0], edges[0.0][1], edges[20.0][1],
+              edges[0.0][2], edges[20.0][2], counts[hs.index(20.0)], edges[75.0][0]), ""]
 
     # 4. Local stresses
     stress_file = os.path.join(ROOT, "sweeps/normal_load/runs/normal_force=1920/stresses.csv")
@@ -437,9 +433,9 @@ def write(data):
         arrest = "-" if e["global"] == "1" else "%.0f" % points[-1][1]
         profile_rows.append("| %s | %.0f–%.0f | %.0f | %s | %.0f | %s |" % (
             label, points[0][0], points[-1][0], min(speeds_here),
-            "%.0f" % statistics_median(running) if running else "-", max(speeds_here), arrest))
+            "%.0f" % float(numpy.median(running)) if running else "-", max(speeds_here), arrest))
         if e["global"] != "1" and running:
-            arrest_ratios.append((points[-1][1] / statistics_median(running), points[-1][1] < C_R))
+            arrest_ratios.append((points[-1][1] / float(numpy.median(running)), points[-1][1] < C_R))
     save_speed_figure(fig5a, ax5a, "x (mm)", "validation_front_profiles.png")
     L += ["Front speed profiles v_c(x) of the default run (speed from a sliding fit of first-unstick times over "
           "%d nodes):" % 5, "", "![v_c(x)](figures/validation_front_profiles.png)", "",
@@ -456,7 +452,7 @@ def write(data):
     # 5b. Front speed against the local pre-stress, node by node, in every run of the h sweep.
     fig5, ax5 = plt.subplots(figsize=(5.6, 3.8))
     correlations, pooled = [], []
-    for k in sorted(heights, key=lambda k: float(k.split("=")[1])):
+    for k, _ in by_value(heights):
         pairs = front_speed_against_prestress(os.path.join(ROOT, "sweeps/pushing_height/runs", k))
         if len(pairs) < 3:
             continue
@@ -473,11 +469,11 @@ def write(data):
     within = [c for _, _, c in correlations] or [math.nan]
     L += ["", "Speeds at or above c_L are left out (see the profiles above). Pooled: %.2f; within single runs "
           "%.2f to %.2f (median %.2f). *Agreement*: %s" % (
-        pooled_corr, min(within), max(within), statistics_median(within),
+        pooled_corr, min(within), max(within), float(numpy.median(within)),
         "yes, moderately: within a run, fronts run faster through more highly stressed interface, as in "
         "Ben-David 2010, but the scatter is wide (the speed also depends on the event: how much elastic "
         "energy the loaded edge releases)."
-        if statistics_median(within) > 0.3 else "weak or none: with Amontons–Coulomb friction the front speed here "
+        if float(numpy.median(within)) > 0.3 else "weak or none: with Amontons–Coulomb friction the front speed here "
         "is set more by the event (how much elastic energy the loaded edge releases) than by the local "
         "pre-stress; the experiment's v_c–τ̄ relation is not reproduced. Reported, not claimed."), ""]
 
@@ -508,8 +504,7 @@ def write(data):
     L += ["## 7. 1D against 2D (the thesis's central claim)", "",
           "![1D against 2D](%s)" % fig7, "", "| model | precursors | µ_s,macro |", "|---|---|---|"]
     for label, events in curves:
-        gg = first_global(events)
-        L.append("| %s | %d | %s |" % (label, len(precursors(events)), "%.4f" % f(gg, "shear_ratio") if gg else "none"))
+        L.append("| %s | %d | %s |" % (label, len(precursors(events)), macro_cell(events)))
     L += ["", "*Reading*: the uniform 1D chain produces many more precursors (tens, alternating long and short) "
           "and reaches global sliding at a lower F_X/F_Z than the 2D slider; θ = 0.3 and g = 1 change the count "
           "and µ_s,macro (table) but do not bring the chain to the 2D slider's few long precursors. The 1D "
@@ -521,10 +516,10 @@ def write(data):
     # 8. Friction law
     laws = data["friction_law"]
     fig8 = figure("validation_friction_law.png", [("slip weakening length ξ_µ (m)",
-                                                    [(k.split("=")[1], v) for k, v in sorted(laws.items(), key=lambda kv: float(kv[0].split("=")[1]))])])
+                                                    [(k.split("=")[1], v) for k, v in by_value(laws)])])
     L += ["## 8. Friction law", "", "![friction law](%s)" % fig8, "",
           "| ξ_µ (m) | precursors | µ_s,macro | median v_c of the global event (m/s) |", "|---|---|---|---|"]
-    for k, v in sorted(laws.items(), key=lambda kv: float(kv[0].split("=")[1])):
+    for k, v in by_value(laws):
         L.append(global_row(k.split("=")[1], v))
     L += ["", "ξ_µ = 0 is Amontons–Coulomb. Slip weakening raises µ_s,macro and slows the global front (from "
           "≈ 1240 m/s to a few hundred m/s at ξ_µ = 1–3 µm); at ξ_µ = 10 µm the first event already runs the "
