@@ -18,18 +18,17 @@ bool SeriesHistory::add(double time, double value) {
 
 void SpaceTimeHistory::clear() {
   rows_.clear();
-  times_.clear();
   events_.clear();
   dropped_ = 0;
 }
 
 bool SpaceTimeHistory::add(double time, const std::vector<double>& positions, const std::vector<double>& values,
                            const std::vector<unsigned char>& states) {
-  const bool jumped_back = !times_.empty() && time < times_.back();
+  const bool jumped_back = !rows_.empty() && time < last_time_;
   if (jumped_back || positions.size() != positions_.size()) clear();
   positions_ = positions;
   rows_.push_back(values);
-  times_.push_back(time);
+  last_time_ = time;
   const std::size_t row = dropped_ + rows_.size() - 1;
   double x_min = 0.0, x_max = 0.0;
   bool sliding = false;
@@ -53,7 +52,6 @@ bool SpaceTimeHistory::add(double time, const std::vector<double>& positions, co
   }
   while (rows_.size() > capacity_) {
     rows_.pop_front();
-    times_.pop_front();
     ++dropped_;
   }
   events_.erase(std::remove_if(events_.begin(), events_.end(),

@@ -164,7 +164,6 @@ void RigPanel::onEvent(const friction_msgs::SlipEvent::ConstPtr& msg) {
 
 void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
   last_state_ = *msg;
-  paused_ = msg->paused;
 }
 
 void RigPanel::refresh() {
@@ -213,7 +212,7 @@ void RigPanel::setNormalLoad() { send(normalLoadCommand(normal_load_->value()));
 
 void RigPanel::togglePause() {
   std_srvs::SetBool call;
-  call.request.data = !paused_;
+  call.request.data = !last_state_.paused;
   const bool ok = pause_client_.call(call);
   reply_label_->setText(ok ? "reply: " + QString::fromStdString(call.response.message) : "reply: no reply from pause");
 }

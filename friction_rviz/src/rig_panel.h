@@ -68,7 +68,6 @@ class RigPanel : public rviz::Panel {
   void onEvent(const friction_msgs::SlipEvent::ConstPtr& msg);
   void onStageState(const friction_msgs::StageState::ConstPtr& msg);
 
-  ros::NodeHandle nh_;
   ros::Subscriber load_cells_sub_, events_sub_, stage_sub_;
   ros::ServiceClient command_client_, pause_client_;
   QLineEdit* namespace_edit_;
@@ -79,7 +78,6 @@ class RigPanel : public rviz::Panel {
   std::vector<double> shear_ratio_, length_ratio_;
   std::vector<bool> global_;
   friction_msgs::StageState last_state_;
-  bool paused_ = false;
 };
 
 }  // namespace friction_rviz

@@ -44,7 +44,6 @@ class SpaceTimeHistory {
 
   std::size_t size() const { return rows_.size(); }
   const std::vector<double>& row(std::size_t i) const { return rows_[i]; }  ///< 0 = oldest kept
-  double rowTime(std::size_t i) const { return times_[i]; }
   const std::vector<double>& positions() const { return positions_; }
   /// Events whose rows are (partly) still kept; row indices relative to the oldest kept row.
   std::vector<StripEvent> visibleEvents() const;
@@ -52,7 +51,7 @@ class SpaceTimeHistory {
  private:
   std::size_t capacity_;
   std::deque<std::vector<double>> rows_;
-  std::deque<double> times_;
+  double last_time_ = 0.0;  ///< s, of the newest row (when there is one), to notice time jumping back
   std::vector<double> positions_;
   std::size_t dropped_ = 0;  ///< rows dropped from the front so far
   std::vector<StripEvent> events_;
