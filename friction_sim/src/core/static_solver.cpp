@@ -5,28 +5,55 @@
 namespace friction {
 
 namespace {
-/// The lower triangle (all the factorisation reads) of the stiffness of the free degrees of freedom
-/// (`position_in_free` is −1 for a fixed one), copied column by column: the free dofs keep their
-/// order, so no triplet list is needed.
-SparseMatrix freeStiffness(const Model& model, const std::vector<int>& position_in_free, int free_count) {
-  const SparseMatrix stiffness = model.stiffnessMatrix();
-  SparseMatrix reduced(free_count, free_count);
-  reduced.reserve(stiffness.nonZeros() / 2 + free_count);
+/// Relative residual at which a multigrid solve stops; the modified-Newton loop corrects the rest.
+constexpr double kMultigridTolerance = 1e-10;
+
+/// The stiffness of the free degrees of freedom (`position_in_free` is −1 for a fixed one). The
+/// model's matrix is compacted in place (entries only move towards the front): a 10⁶-node lattice's
+/// stiffness takes 450 MB, too much to copy. `lower_only` keeps the lower triangle, all the
+/// factorisation reads.
+SparseMatrix freeStiffness(const Model& model, const std::vector<int>& position_in_free, int free_count,
+                           bool lower_only) {
+  SparseMatrix stiffness = model.stiffnessMatrix();
+  stiffness.makeCompressed();
+  int* outer = stiffness.outerIndexPtr();
+  int* inner = stiffness.innerIndexPtr();
+  double* value = stiffness.valuePtr();
+  int written = 0;
+  int column_start = outer[0];
   for (int column = 0; column < stiffness.outerSize(); ++column) {
+    const int column_end = outer[column + 1];
     const int col = position_in_free[column];
-    if (col < 0) continue;
-    reduced.startVec(col);
-    for (SparseMatrix::InnerIterator it(stiffness, column); it; ++it) {
-      const int row = position_in_free[it.row()];
-      if (row >= col) reduced.insertBack(row, col) = it.value();
+    if (col >= 0) {
+      outer[col] = written;  // col ≤ column: that start has been read already
+      for (int k = column_start; k < column_end; ++k) {
+        const int row = position_in_free[inner[k]];
+        if (row < (lower_only ? col : 0)) continue;
+        inner[written] = row;
+        value[written++] = value[k];
+      }
     }
+    column_start = column_end;
   }
-  reduced.finalize();
-  return reduced;
+  outer[free_count] = written;
+  stiffness.data().resize(written);
+  stiffness.conservativeResize(free_count, free_count);
+  stiffness.makeCompressed();
+  if (lower_only) stiffness.data().squeeze();
+  return stiffness;
+}
+
+/// The model's dofs as a grid of nodes; components = 0 if they are not laid out as one.
+GridLayout gridLayoutOf(const Model& model) {
+  const auto shape = model.gridShape();
+  const int nodes = shape[0] * shape[1];
+  if (nodes <= 0 || model.dofCount() % nodes != 0) return {shape[0], shape[1], 0};
+  return {shape[0], shape[1], model.dofCount() / nodes};
 }
 }  // namespace
 
-StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load)
+StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load,
+                           StaticMethod method)
     : balance_load_(balance_load) {
   const int n = model.dofCount();
   std::vector<char> fixed(n, 0);
@@ -39,17 +66,37 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
   }
   tolerance_ = 1e-14 * model.nodeSpacing() * std::max(model.gridShape()[0], 1);
   if (free_dofs_.empty()) return;
+  const int free_count = static_cast<int>(free_dofs_.size());
+  const GridLayout layout = gridLayoutOf(model);
+  if (method == StaticMethod::kAuto) {
+    method = free_count > kDirectSolveDofs && layout.components > 0 ? StaticMethod::kMultigrid : StaticMethod::kDirect;
+  }
+  if (method == StaticMethod::kMultigrid) {
+    if (layout.components == 0) throw std::invalid_argument("static solve: multigrid needs a grid model");
+    multigrid_ = std::make_unique<GridMultigrid>(freeStiffness(model, position_in_free, free_count, false),
+                                                 free_dofs_, layout);
+    return;
+  }
   // Built in a function of its own so that the full matrix is freed before the factorisation, the
   // memory peak of a large lattice.
-  const SparseMatrix reduced = freeStiffness(model, position_in_free, static_cast<int>(free_dofs_.size()));
-  factor_.compute(reduced);
-  if (factor_.info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
+  const SparseMatrix reduced = freeStiffness(model, position_in_free, free_count, true);
+  factor_ = std::make_unique<Eigen::CholmodSupernodalLLT<SparseMatrix>>(reduced);
+  if (factor_->info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
 }
+
+StaticSolver::~StaticSolver() = default;
 
 Vector StaticSolver::response(const Vector& force) const {
   Vector reduced(free_dofs_.size());
   for (std::size_t i = 0; i < free_dofs_.size(); ++i) reduced[i] = force[free_dofs_[i]];
-  const Vector solution = free_dofs_.empty() ? reduced : Vector(factor_.solve(reduced));
+  Vector solution;
+  if (multigrid_) {
+    solution = multigrid_->solve(reduced, kMultigridTolerance);
+  } else if (factor_) {
+    solution = factor_->solve(reduced);
+  } else {
+    solution = reduced;  // no free degree of freedom
+  }
   Vector out = Vector::Zero(force.size());
   for (std::size_t i = 0; i < free_dofs_.size(); ++i) out[free_dofs_[i]] = solution[i];
   return out;
