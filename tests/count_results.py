@@ -28,7 +28,7 @@ for path in sorted(pathlib.Path(sys.argv[1]).rglob("*.xml")):
         for case in root.iter("testcase"):
             for problem in list(case.findall("failure")) + list(case.findall("error")):
                 text = (problem.get("message") or "") + "\n" + (problem.text or "")
-                lines = [line for line in text.strip().splitlines() if line.strip()][-12:]
+                lines = [line for line in text.strip().splitlines() if line.strip()][:12]
                 print(f"  {case.get('classname', '')}.{case.get('name')}:")
                 for line in lines:
                     print(f"    {line}")

@@ -78,8 +78,11 @@ class SweepTest(unittest.TestCase):
         calls = os.path.join(self.work, "ssh_calls.txt")
         stand_in = os.path.join(self.work, "ssh")
         with open(stand_in, "w") as handle:
-            # parallel calls `ssh HOST -- COMMAND...`, the command meant for the remote shell.
-            handle.write('#!/bin/sh\necho "$1" >> %s\nshift\n[ "$1" = "--" ] && shift\nexec /bin/sh -c "$*"\n' % calls)
+            # parallel calls `ssh HOST -- COMMAND...`, the command meant for the remote shell. sshd sets
+            # SHELL, which parallel's remote side runs the job with (without it the job silently does
+            # nothing and exits 0; CI runs the tests without SHELL).
+            handle.write('#!/bin/sh\necho "$1" >> %s\nshift\n[ "$1" = "--" ] && shift\n'
+                         'SHELL=/bin/sh; export SHELL\nexec /bin/sh -c "$*"\n' % calls)
         # Through /bin/sh, so that a temporary directory mounted noexec does not matter.
         os.environ["PARALLEL_SSH"] = "/bin/sh " + stand_in
         try:
