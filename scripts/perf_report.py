@@ -170,13 +170,14 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
     for w in whole:
         lines.append("| %s | %.2f | %.0f |" % (w["label"], w["wall"], w["peak_mb"]))
     big = whole[1]
-    lines += ["", "The 10⁶-node run's peak is %s the 2 GB target. Measured by hand on this machine (2026-11-21, not "
-              "by this script): the loading solve's Cholesky factor of the 2.1·10⁶ free degrees of freedom has "
-              "2.4·10⁸ non-zeros (2.2 GB with CHOLMOD's supernodal padding) whichever ordering CHOLMOD uses (AMD, "
-              "METIS and its nested dissection within 5 %% of each other; a 2D lattice's factor grows as n log n); "
-              "the same run without the loading solve peaks at 0.92 GB. Conjugate gradients with Eigen's incomplete "
-              "Cholesky would fit in memory but needed 2100 iterations and 65 s per solve at 501 × 501 already; "
-              "without a multigrid preconditioner in the allowed libraries the direct factor stays." % (
+    lines += ["", "The 10⁶-node run's peak is %s the 2 GB target. Its loading solve (2.1·10⁶ free degrees of freedom) "
+              "uses conjugate gradients preconditioned by a geometric multigrid V-cycle (`GridMultigrid`: bilinear "
+              "transfer, Galerkin coarse matrices, one Gauss–Seidel sweep each way, CHOLMOD on the coarsest level); "
+              "lattices above 4·10⁵ free degrees of freedom use it, smaller ones CHOLMOD's direct factor. Measured by "
+              "hand on this machine (2026-11-21): the direct factor has 2.4·10⁸ non-zeros at 10⁶ nodes (2.2 GB, "
+              "whatever ordering CHOLMOD uses) and the same run with it peaked at 2957 MB in 144 s; multigrid needs "
+              "11–12 iterations to a 10⁻¹⁰ residual at 57 × 31, 113 × 61 and 225 × 121 alike (tested). The stability "
+              "limit's Lanczos estimates (stiffness and damping) take about 15 s of the wall time (perf)." % (
                   "over" if big["peak_mb"] > 2048 else "under")]
     lines += ["", "## Every mode against the reference", "",
               "Scene `pmma_2d` to its first global event. Reference: velocity Verlet, dt = 50 ns, full dynamics "
