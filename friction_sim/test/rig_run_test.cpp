@@ -6,6 +6,7 @@
 //     and the live run equals an offline run of the same scene and commands.
 //   mode "kill": the simulator killed mid-run leaves a readable bag with everything up to the kill.
 #include <friction_msgs/InterfaceState.h>
+#include <friction_msgs/LatticeSnapshot.h>
 #include <friction_msgs/PrecursorPoint.h>
 #include <friction_msgs/SendStageCommand.h>
 #include <friction_msgs/SlipEvent.h>
@@ -38,6 +39,8 @@ struct Observed {
   int gauge_profiles = 0;
   double last_stage_time = 0.0;
   int stage_states = 0;
+  int lattice_snapshots = 0;
+  friction_msgs::LatticeSnapshot last_lattice;
   std::map<std::string, std::string> topic_types;
   std::vector<friction_msgs::SendStageCommand::Response> bad_command_replies;
   double time_after_bad_commands = 0.0;
@@ -126,6 +129,38 @@ TEST(FullRun, TopicsHaveTheirTypesAndSimulatedTimeStamps) {
   EXPECT_GT(g_seen.stage_states, 0);
 }
 
+TEST(FullRun, LatticeSnapshotsShowTheLoadedSlider) {
+  ASSERT_GT(g_seen.lattice_snapshots, 0);
+  const auto& lattice = g_seen.last_lattice;
+  ros::NodeHandle pnh("~");
+  std::string scene_path;
+  pnh.getParam("scene", scene_path);
+  const Scene scene = loadScene(scene_path);
+  ASSERT_EQ(lattice.nodes_x, static_cast<unsigned>(scene.lattice.nodes_x));
+  ASSERT_EQ(lattice.nodes_z, static_cast<unsigned>(scene.lattice.nodes_z));
+  const std::size_t nodes = lattice.nodes_x * lattice.nodes_z;
+  for (const auto* field : {&lattice.x, &lattice.z, &lattice.speed, &lattice.sigma_xx, &lattice.sigma_zz, &lattice.tau_xz}) {
+    ASSERT_EQ(field->size(), nodes);
+  }
+  ASSERT_EQ(lattice.interface_state.size(), lattice.nodes_x);
+  EXPECT_DOUBLE_EQ(lattice.spacing, scene.geometry.length / (scene.lattice.nodes_x - 1));
+  EXPECT_DOUBLE_EQ(lattice.normal_force, scene.load.normal_force);
+  // Nodes sit at their rest places give or take the micrometres of elastic displacement and slip.
+  double top_sigma_zz = 0.0;
+  for (std::size_t j = 0; j < lattice.nodes_z; ++j) {
+    for (std::size_t i = 0; i < lattice.nodes_x; ++i) {
+      const std::size_t node = j * lattice.nodes_x + i;
+      EXPECT_NEAR(lattice.z[node], j * lattice.spacing, 1e-4);
+      EXPECT_NEAR(lattice.x[node] - lattice.x[j * lattice.nodes_x], i * lattice.spacing, 1e-4);
+      if (j + 1 == lattice.nodes_z) top_sigma_zz += lattice.sigma_zz[node] / lattice.nodes_x;
+    }
+  }
+  // Under the uniform top load the top row carries σ_zz = −F_Z/(L·B); the corners' half-cells and
+  // the pusher's moment leave a few per cent.
+  const double applied = -scene.load.normal_force / (scene.geometry.length * scene.geometry.width);
+  EXPECT_NEAR(top_sigma_zz, applied, 0.05 * std::abs(applied)) << "top row mean σ_zz " << top_sigma_zz;
+}
+
 TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
   ASSERT_EQ(g_seen.bad_command_replies.size(), 3u);
   for (const auto& reply : g_seen.bad_command_replies) {
@@ -208,7 +243,10 @@ void watchFullRun(ros::NodeHandle& nh) {
                                                            ++g_seen.stage_states;
                                                            g_seen.last_stage_time = m->header.stamp.toSec();
                                                          }));
-  subs.push_back(listen<friction_msgs::LatticeSnapshot>(nh, "/rig/lattice", [](const friction_msgs::LatticeSnapshot::ConstPtr&) {}));
+  subs.push_back(listen<friction_msgs::LatticeSnapshot>(nh, "/rig/lattice", [](const friction_msgs::LatticeSnapshot::ConstPtr& m) {
+                                                                ++g_seen.lattice_snapshots;
+                                                                g_seen.last_lattice = *m;
+                                                              }));
   // While the rig runs: bad commands, then a bad scene and a bad parameter for a second simulator.
   waitFor([] { return g_seen.last_stage_time > 1e-3; }, 60.0);
   ros::ServiceClient client = nh.serviceClient<friction_msgs::SendStageCommand>("/rig/send_command");
