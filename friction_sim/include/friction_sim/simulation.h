@@ -88,8 +88,14 @@ class Simulation : public Dynamics {
   /// its threshold and in contact. Applies it (the energy of the ring-down it skips is counted as
   /// viscous dissipation) and returns true; otherwise leaves the state as it is.
   bool relaxToStaticEquilibrium();
-  /// The jump of `advance`; returns false if a dynamic step is needed instead.
+  /// The jumps of `advance`; returns false if a dynamic step is needed instead.
   bool fastForward(double until);
+  /// One jump along the pinned equilibrium towards `until` or, if sooner, the next node's threshold
+  /// (then `toward_threshold`, and the jump covers kApproachShare of the way). Returns false, jumping
+  /// nowhere, if less than a step is left.
+  bool jumpAlongEquilibrium(double until, bool& toward_threshold);
+  /// Share of the way to an estimated threshold crossing that one jump covers.
+  static constexpr double kApproachShare = 0.9;
   void refreshAfterStaticChange();
   void reapplyFriction();
   void checkStop();
