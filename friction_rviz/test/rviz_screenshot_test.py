@@ -4,7 +4,9 @@
 Starts rviz (the test's DISPLAY is an Xvfb screen), takes a screenshot while every node sticks and
 another with the simulator paused in the middle of a slip event, and asserts: rviz printed no error
 (plugin not loaded, display error, exception); the slider is drawn in the 3D view; the interface band
-is blue (stuck) in the first and has red (sliding) nodes in the second.
+is blue (stuck) in the first and has red (sliding) nodes in the second, towards the trailing edge where
+the slip starts. The band is found as the rows that are blue in the first screenshot, so that the red
+of the stress colours and the colour bar does not count.
 """
 import os
 import subprocess
@@ -34,13 +36,18 @@ def screenshot(path):
     return image[VIEW]
 
 
-def counts(region):
+def ink(region):
+    return (region.sum(axis=2) < 2.4)
+
+
+def stuck_blue(region):
     r, g, b = region[..., 0], region[..., 1], region[..., 2]
-    return {
-        "ink": int(((r + g + b) < 2.4).sum()),
-        "stuck_blue": int(((b > 0.85) & (r < 0.3) & (g < 0.5)).sum()),
-        "sliding_red": int(((r > 0.85) & (g < 0.3) & (b < 0.3)).sum()),
-    }
+    return (b > 0.85) & (r < 0.3) & (g < 0.5)
+
+
+def sliding_red(region):
+    r, g, b = region[..., 0], region[..., 1], region[..., 2]
+    return (r > 0.85) & (g < 0.3) & (b < 0.3)
 
 
 class RvizScreenshot(unittest.TestCase):
@@ -56,14 +63,18 @@ class RvizScreenshot(unittest.TestCase):
         rospy.wait_for_service("/rig/pause", timeout=60)
         cls.pause = rospy.ServiceProxy("/rig/pause", SetBool, persistent=True)
         time.sleep(12.0)  # rviz starts, loads the plugins, draws the loading slider
-        cls.stuck = counts(screenshot(os.path.join(cls.out, "stuck.png")))
+        cls.stuck = screenshot(os.path.join(cls.out, "stuck.png"))
         # Pause the rig from the frame callback itself, while the event is still under way.
         rospy.Subscriber("/rig/interface", InterfaceState, cls.on_frame, queue_size=1)
         deadline = time.time() + 120
         while cls.sliding_frame is None and time.time() < deadline:
             time.sleep(0.01)
         time.sleep(3.0)
-        cls.sliding = counts(screenshot(os.path.join(cls.out, "sliding.png")))
+        cls.sliding = screenshot(os.path.join(cls.out, "sliding.png"))
+        blue = stuck_blue(cls.stuck)
+        cls.band_rows = numpy.flatnonzero(blue.sum(axis=1) > 50)
+        columns = numpy.flatnonzero(blue.any(axis=0))
+        cls.band_columns = (columns.min(), columns.max()) if columns.size else (0, 0)
         cls.pause(False)
         cls.rviz.terminate()
         cls.rviz.wait(timeout=30)
@@ -82,16 +93,28 @@ class RvizScreenshot(unittest.TestCase):
                and not any(noise in line for noise in NOISE)]
         self.assertEqual(bad, [], "rviz printed:\n" + "\n".join(bad))
 
+    def band(self, region):
+        """The interface band's rows (one row of margin) of a screenshot's view."""
+        return region[max(self.band_rows.min() - 1, 0):self.band_rows.max() + 2]
+
     def test_slider_is_drawn_in_the_view(self):
-        self.assertGreater(self.stuck["ink"], 20000, self.stuck)
+        self.assertGreater(int(ink(self.stuck).sum()), 20000)
 
     def test_interface_band_is_blue_while_stuck(self):
-        self.assertGreater(self.stuck["stuck_blue"], 300, self.stuck)
-        self.assertLess(self.stuck["sliding_red"], 50, self.stuck)
+        # A thin horizontal band across the slider's length, blue with no red.
+        self.assertGreater(len(self.band_rows), 0)
+        self.assertLess(len(self.band_rows), 15, self.band_rows)
+        self.assertGreater(self.band_columns[1] - self.band_columns[0], 300, self.band_columns)
+        self.assertGreater(int(stuck_blue(self.band(self.stuck)).sum()), 300)
+        self.assertLess(int(sliding_red(self.band(self.stuck)).sum()), 20)
 
     def test_interface_band_turns_red_where_it_slides(self):
         self.assertIsNotNone(self.sliding_frame)
-        self.assertGreater(self.sliding["sliding_red"], 100, self.sliding)
+        red_columns = numpy.flatnonzero(sliding_red(self.band(self.sliding)).any(axis=0))
+        self.assertGreater(int(sliding_red(self.band(self.sliding)).sum()), 100)
+        # The slip starts at the trailing edge (x = 0, the band's left end): so do the red nodes.
+        middle = 0.5 * (self.band_columns[0] + self.band_columns[1])
+        self.assertLess(red_columns.mean(), middle, (red_columns.min(), red_columns.max(), self.band_columns))
 
 
 if __name__ == "__main__":
