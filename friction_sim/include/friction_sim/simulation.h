@@ -96,6 +96,8 @@ class Simulation : public Dynamics {
   bool jumpAlongEquilibrium(double until, bool& toward_threshold);
   /// Share of the way to an estimated threshold crossing that one jump covers.
   static constexpr double kApproachShare = 0.9;
+  /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about five).
+  static constexpr int kMaxApproachJumps = 50;
   void refreshAfterStaticChange();
   void reapplyFriction();
   void checkStop();

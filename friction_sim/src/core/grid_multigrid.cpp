@@ -17,30 +17,50 @@ constexpr int kMaxIterations = 500;
 struct AxisCoarsening {
   int coarse = 0;
   std::vector<std::array<std::pair<int, double>, 2>> weights;
+  std::vector<int> place;  ///< the fine node at each coarse node's place
 
   explicit AxisCoarsening(int fine) : weights(fine) {
     coarse = fine <= 2 ? fine : fine / 2 + 1;
-    auto position = [&](int node) { return fine <= 2 ? node : std::min(2 * node, fine - 1); };
+    for (int node = 0; node < coarse; ++node) place.push_back(fine <= 2 ? node : std::min(2 * node, fine - 1));
     for (int i = 0; i < fine; ++i) {
       if (coarse == fine) {
         weights[i] = {{{i, 1.0}, {i, 0.0}}};
         continue;
       }
       const int left = std::min(i / 2, coarse - 2);
-      const double along = double(i - position(left)) / (position(left + 1) - position(left));
+      const double along = double(i - place[left]) / (place[left + 1] - place[left]);
       weights[i] = {{{left, 1.0 - along}, {left + 1, along}}};
     }
   }
 };
 
 /// Restriction (transpose of the bilinear prolongation) from the grid dofs `free_dofs` of `layout`
-/// to every dof of the coarse grid, built column by column (≤ 4 entries each, rows ascending).
-SparseMatrix restriction(const std::vector<int>& free_dofs, const GridLayout& layout, GridLayout& coarse) {
+/// to the coarse grid, built column by column (≤ 4 entries each, rows ascending). A coarse dof is
+/// kept only where the fine dof at its place is free (`coarse_dofs` lists them): that fine dof
+/// interpolates from it alone, so the rows of R are independent and R·A·Rᵀ stays positive definite
+/// whatever is fixed.
+SparseMatrix restriction(const std::vector<int>& free_dofs, const GridLayout& layout, GridLayout& coarse,
+                         std::vector<int>& coarse_dofs) {
   const AxisCoarsening along_x(layout.nodes_x), along_z(layout.nodes_z);
   coarse = {along_x.coarse, along_z.coarse, layout.components};
   const int nodes = layout.nodes_x * layout.nodes_z;
   const int coarse_nodes = coarse.nodes_x * coarse.nodes_z;
-  SparseMatrix out(coarse_nodes * coarse.components, static_cast<int>(free_dofs.size()));
+  std::vector<char> free(nodes * layout.components, 0);
+  for (int dof : free_dofs) free[dof] = 1;
+  std::vector<int> coarse_index(coarse_nodes * coarse.components, -1);
+  coarse_dofs.clear();
+  for (int component = 0; component < coarse.components; ++component) {
+    for (int j = 0; j < coarse.nodes_z; ++j) {
+      const int fine_row = along_z.place[j];
+      for (int i = 0; i < coarse.nodes_x; ++i) {
+        if (!free[component * nodes + fine_row * layout.nodes_x + along_x.place[i]]) continue;
+        const int dof = component * coarse_nodes + j * coarse.nodes_x + i;
+        coarse_index[dof] = static_cast<int>(coarse_dofs.size());
+        coarse_dofs.push_back(dof);
+      }
+    }
+  }
+  SparseMatrix out(static_cast<int>(coarse_dofs.size()), static_cast<int>(free_dofs.size()));
   out.reserve(4 * free_dofs.size());
   for (std::size_t column = 0; column < free_dofs.size(); ++column) {
     const int component = free_dofs[column] / nodes;
@@ -49,9 +69,9 @@ SparseMatrix restriction(const std::vector<int>& free_dofs, const GridLayout& la
     for (const auto& [j, weight_z] : along_z.weights[node / layout.nodes_x]) {
       if (weight_z == 0.0) continue;
       for (const auto& [i, weight_x] : along_x.weights[node % layout.nodes_x]) {
-        if (weight_x == 0.0) continue;
-        out.insertBack(component * coarse_nodes + j * coarse.nodes_x + i, static_cast<int>(column)) =
-            weight_x * weight_z;
+        const int row = coarse_index[component * coarse_nodes + j * coarse.nodes_x + i];
+        if (weight_x == 0.0 || row < 0) continue;
+        out.insertBack(row, static_cast<int>(column)) = weight_x * weight_z;
       }
     }
   }
@@ -124,9 +144,10 @@ GridMultigrid::GridMultigrid(SparseMatrix matrix, const std::vector<int>& free_d
   // matrices have no move constructor: they are swapped into place, and the vector is reserved so
   // that growing it never copies them.
   levels_.reserve(64);
+  std::vector<int> coarse_dofs;
   while (matrix.rows() > kCoarsestDofs) {
     GridLayout coarse;
-    SparseMatrix restrict_to_coarse = restriction(dofs, grid, coarse);
+    SparseMatrix restrict_to_coarse = restriction(dofs, grid, coarse, coarse_dofs);
     if (restrict_to_coarse.rows() >= matrix.rows()) break;
     SparseMatrix coarse_matrix = galerkinProduct(matrix, restrict_to_coarse);
     Level& level = levels_.emplace_back();
@@ -134,8 +155,7 @@ GridMultigrid::GridMultigrid(SparseMatrix matrix, const std::vector<int>& free_d
     level.matrix.swap(matrix);
     level.restriction.swap(restrict_to_coarse);
     matrix.swap(coarse_matrix);
-    dofs.resize(matrix.rows());
-    for (int dof = 0; dof < matrix.rows(); ++dof) dofs[dof] = dof;
+    dofs.swap(coarse_dofs);
     grid = coarse;
   }
   coarsest_.compute(matrix);

@@ -85,9 +85,14 @@ bool Simulation::fastForward(double until) {
   // node over, and the result no longer depends on where the jumps were cut (`until`).
   bool jumped = false;
   bool toward_threshold = true;
-  while (toward_threshold && jumpAlongEquilibrium(until, toward_threshold)) {
+  for (int jump = 1; toward_threshold && jumpAlongEquilibrium(until, toward_threshold); ++jump) {
     jumped = true;
     if (event_started_ || finished()) break;
+    // A crossing that keeps receding (met tangentially) is left to the dynamics.
+    if (jump == kMaxApproachJumps) {
+      approaching_threshold_ = toward_threshold;
+      break;
+    }
   }
   return jumped;
 }

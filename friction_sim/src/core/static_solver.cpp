@@ -9,9 +9,9 @@ namespace {
 constexpr double kMultigridTolerance = 1e-10;
 
 /// The stiffness of the free degrees of freedom (`position_in_free` is −1 for a fixed one). The
-/// model's matrix is compacted in place (entries only move towards the front): a 10⁶-node lattice's
-/// stiffness takes 450 MB, too much to copy. `lower_only` keeps the lower triangle, all the
-/// factorisation reads.
+/// model's matrix is compacted in place (entries only move towards the front) rather than copied into
+/// a second matrix: a 10⁶-node lattice's stiffness takes 450 MB. Trimming the storage to its new size
+/// still reallocates once. `lower_only` keeps the lower triangle, all the factorisation reads.
 SparseMatrix freeStiffness(const Model& model, const std::vector<int>& position_in_free, int free_count,
                            bool lower_only) {
   SparseMatrix stiffness = model.stiffnessMatrix();
@@ -69,12 +69,15 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
   const int free_count = static_cast<int>(free_dofs_.size());
   const GridLayout layout = gridLayoutOf(model);
   if (method == StaticMethod::kAuto) {
-    method = free_count > kDirectSolveDofs && layout.components > 0 ? StaticMethod::kMultigrid : StaticMethod::kDirect;
+    // A chain's factor has no fill-in: only a 2D grid gains from multigrid.
+    const bool grid_2d = layout.components > 0 && layout.nodes_x > 2 && layout.nodes_z > 2;
+    method = free_count > kDirectSolveDofs && grid_2d ? StaticMethod::kMultigrid : StaticMethod::kDirect;
   }
   if (method == StaticMethod::kMultigrid) {
     if (layout.components == 0) throw std::invalid_argument("static solve: multigrid needs a grid model");
-    multigrid_ = std::make_unique<GridMultigrid>(freeStiffness(model, position_in_free, free_count, false),
-                                                 free_dofs_, layout);
+    // Not make_unique: it would pass the matrix on by reference, and Eigen 3.4's sparse matrices,
+    // having no move constructor, would be copied (360 MB at 10⁶ nodes).
+    multigrid_.reset(new GridMultigrid(freeStiffness(model, position_in_free, free_count, false), free_dofs_, layout));
     return;
   }
   // Built in a function of its own so that the full matrix is freed before the factorisation, the
