@@ -127,7 +127,7 @@ class Simulation : public Dynamics {
   Vector external_reference_u_;         ///< displacements at the last change of F_Z
   double viscous_dissipation_ = 0.0;
   // Fast-forward.
-  std::unique_ptr<StaticSolver> pinned_solver_;  ///< factored once, for the interface pinned, pusher on
+  std::unique_ptr<StaticSolver> pinned_solver_;  ///< set up once (factor or multigrid), interface pinned, pusher on
   bool quasi_static_ = false;
   bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
   long long jumps_ = 0;
