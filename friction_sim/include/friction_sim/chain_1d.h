@@ -79,7 +79,6 @@ class Chain1D : public Model {
   Vector pusher_offset_;                ///< m, u of each block when the pusher was connected
   bool pusher_connected_ = true;
   Eigen::ArrayXd driving_stiffness_;    ///< N/m per block, 0 where the pusher does not act
-  mutable Vector bond_force_;           ///< N, work space of evaluateInto(): bond tensions, zero-padded
 };
 
 }  // namespace friction

@@ -21,8 +21,7 @@ Chain1D::Chain1D(const Scene& scene)
       normal_force_(scene.load.normal_force),
       xi_(Eigen::ArrayXd::Zero(n_)),
       initial_shear_(scene.chain.initial_shear),
-      pusher_offset_(Vector::Zero(n_)),
-      bond_force_(Vector::Zero(n_ + 1)) {
+      pusher_offset_(Vector::Zero(n_)) {
   if (n_ > 1) {
     for (int i = 0; i < n_; ++i) xi_[i] = 2.0 * i * spacing_ / length_ - 1.0;
   }
@@ -56,11 +55,21 @@ std::vector<double> Chain1D::normalForces(double shear_force) const {
 
 void Chain1D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                            ForceEvaluation& out) const {
-  const auto du = u.tail(n_ - 1).array() - u.head(n_ - 1).array();
   const auto dv = v.tail(n_ - 1).array() - v.head(n_ - 1).array();
-  // bond_force_[b + 1] is the tension of the bond between blocks b and b + 1; the ends stay zero.
-  bond_force_.segment(1, n_ - 1) = k_ * du + eta_ * dv;
-  force = bond_force_.tail(n_) - bond_force_.head(n_);
+  force.resize(n_);
+  const double* __restrict x = u.data();
+  const double* __restrict w = v.data();
+  double* __restrict f = force.data();
+  // The tension of the bond between blocks i and i + 1, computed for both of its blocks rather than
+  // stored: one pass that vectorises, with the round-off of a stored tension.
+  auto tension = [&](int i) { return k_ * (x[i + 1] - x[i]) + eta_ * (w[i + 1] - w[i]); };
+  if (n_ == 1) {
+    f[0] = 0.0;
+  } else {
+    f[0] = tension(0);
+    for (int i = 1; i + 1 < n_; ++i) f[i] = tension(i) - tension(i - 1);
+    f[n_ - 1] = -tension(n_ - 2);
+  }
   const auto driving = driving_stiffness_ * (stage_position + pusher_offset_.array() - u.array());
   double shear = 0.0;
   if (top_driving_) {
