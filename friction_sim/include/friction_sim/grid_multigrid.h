@@ -4,7 +4,6 @@
 #pragma once
 
 #include <Eigen/CholmodSupport>
-#include <memory>
 #include <vector>
 
 #include "friction_sim/model.h"
@@ -26,14 +25,12 @@ class GridMultigrid {
   /// take every other node along each axis (plus the last), with bilinear interpolation and Galerkin
   /// coarse matrices, down to about a thousand degrees of freedom, which are factored.
   GridMultigrid(SparseMatrix matrix, const std::vector<int>& free_dofs, const GridLayout& layout);
-  ~GridMultigrid();
 
   /// Solves matrix·x = rhs until ‖rhs − matrix·x‖ ≤ relative_tolerance·‖rhs‖. Throws
   /// std::runtime_error if that is not reached within 500 iterations.
   Vector solve(const Vector& rhs, double relative_tolerance) const;
   /// Conjugate-gradient iterations of the last solve.
   int lastIterations() const { return last_iterations_; }
-  int levelCount() const { return static_cast<int>(levels_.size()) + 1; }
 
  private:
   struct Level {

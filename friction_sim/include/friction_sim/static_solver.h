@@ -33,7 +33,6 @@ class StaticSolver {
   /// std::runtime_error if that stiffness is singular.
   StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load = false,
                StaticMethod method = StaticMethod::kAuto);
-  ~StaticSolver();
 
   /// Moves the free degrees of freedom of `u` to equilibrium with the stage at `stage_position` (m)
   /// and the extra forces `body_force` (N per dof; empty = none). The fixed ones stay as they are.

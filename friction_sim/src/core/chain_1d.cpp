@@ -55,7 +55,6 @@ std::vector<double> Chain1D::normalForces(double shear_force) const {
 
 void Chain1D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                            ForceEvaluation& out) const {
-  const auto dv = v.tail(n_ - 1).array() - v.head(n_ - 1).array();
   force.resize(n_);
   const double* __restrict x = u.data();
   const double* __restrict w = v.data();
@@ -81,7 +80,7 @@ void Chain1D::evaluateInto(const Vector& u, const Vector& v, double stage_positi
   }
   out.shear_force = shear;
   out.normal_load = normal_force_;
-  out.viscous_power = eta_ * dv.square().sum();
+  out.viscous_power = eta_ * (v.tail(n_ - 1).array() - v.head(n_ - 1).array()).square().sum();
   out.normal_force = normalForceExpression(shear).max(0.0);
 }
 

@@ -162,8 +162,6 @@ GridMultigrid::GridMultigrid(SparseMatrix matrix, const std::vector<int>& free_d
   if (coarsest_.info() != Eigen::Success) throw std::runtime_error("multigrid: the coarsest matrix is singular");
 }
 
-GridMultigrid::~GridMultigrid() = default;
-
 Vector GridMultigrid::cycle(std::size_t level, const Vector& rhs) const {
   if (level == levels_.size()) return coarsest_.solve(rhs);
   const Level& here = levels_[level];

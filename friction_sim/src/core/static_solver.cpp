@@ -80,14 +80,10 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
     multigrid_.reset(new GridMultigrid(freeStiffness(model, position_in_free, free_count, false), free_dofs_, layout));
     return;
   }
-  // Built in a function of its own so that the full matrix is freed before the factorisation, the
-  // memory peak of a large lattice.
   const SparseMatrix reduced = freeStiffness(model, position_in_free, free_count, true);
   factor_ = std::make_unique<Eigen::CholmodSupernodalLLT<SparseMatrix>>(reduced);
   if (factor_->info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
 }
-
-StaticSolver::~StaticSolver() = default;
 
 Vector StaticSolver::response(const Vector& force) const {
   Vector reduced(free_dofs_.size());
