@@ -26,9 +26,16 @@ from sweep import first_global, precursors  # noqa: E402
 ROOT = sweep.ROOT
 FIG = os.path.join(ROOT, "docs/figures")
 E, RHO = 3.0e9, 1200.0
+MU_S, MU_K = 0.4, 0.17  # pmma_2d's Amontons–Coulomb coefficients
 C_S = math.sqrt(3 * E / 8 / RHO)
 C_R = 0.919 * C_S
 C_L = math.sqrt(E / (RHO * (1 - 1 / 9.0)))
+
+
+def interface_ratio(row):
+    """τ/σ at an interface node of a stresses.csv row; NaN where the node carries no normal stress."""
+    sigma = float(row["interface_normal_stress_Pa"])
+    return float(row["interface_shear_stress_Pa"]) / sigma if sigma > 0 else math.nan
 
 
 def runs_of(rows):
@@ -52,7 +59,7 @@ def front(events):
     return out
 
 
-def fit_force_balance(events, mu_k=0.17):
+def fit_force_balance(events, mu_k=MU_K):
     pts = [(f(e, "shear_ratio"), f(e, "length_ratio")) for e in front(events)]
     if len(pts) < 2:
         return None
@@ -100,12 +107,12 @@ def fit_kink(points):
             "over_parabola": bic(parabola_rss, 3) - bic(best[0], 4)}
 
 
-def front_speed_against_prestress(run_dir, mu_s=0.4, mu_k=0.17):
+def front_speed_against_prestress(run_dir, mu_s=MU_S, mu_k=MU_K):
     """(τ̄ at the event's onset, v_c) for every node a front crossed in one run, below c_L (faster fits are
     nodes unsticking almost together)."""
     with open(os.path.join(run_dir, "stresses.csv")) as handle:
-        prestress = {(r["event"], r["x_m"]): float(r["interface_shear_stress_Pa"]) / float(r["interface_normal_stress_Pa"])
-                     for r in csv.DictReader(handle) if r["phase"] == "onset" and float(r["interface_normal_stress_Pa"]) > 0}
+        prestress = {(r["event"], r["x_m"]): interface_ratio(r) for r in csv.DictReader(handle)
+                     if r["phase"] == "onset" and math.isfinite(interface_ratio(r))}
     with open(os.path.join(run_dir, "event_nodes.csv")) as handle:
         nodes = list(csv.DictReader(handle))
     pairs = []
@@ -291,8 +298,9 @@ def write(data):
     for k, v in by_value(heights):
         gg = first_global(v)
         hs.append(float(k.split("=")[1]) * 1e3)
-        counts.append(len(precursors(v)))
-        single.append(sum(1 for e in precursors(v) if f(e, "rupture_length_m") == 0))
+        before = precursors(v)
+        counts.append(len(before))
+        single.append(sum(1 for e in before if f(e, "rupture_length_m") == 0))
         macros.append(f(gg, "shear_ratio") if gg else math.nan)
     ax[0].plot(hs, counts, "o-")
     ax[0].set_xlabel("h (mm)")
@@ -321,7 +329,7 @@ def write(data):
             rows = [r for r in csv.DictReader(handle) if r["event"] == "0" and r["phase"] == "onset"]
         x = [float(r["x_m"]) * 1e3 for r in rows]
         sigma = [float(r["interface_normal_stress_Pa"]) for r in rows]
-        ratio = [float(r["interface_shear_stress_Pa"]) / n if n > 0 else math.nan for r, n in zip(rows, sigma)]
+        ratio = [interface_ratio(r) for r in rows]
         onset_profiles[h] = (x, sigma, ratio)
         ax3b[0].plot(x, [v / 1e6 for v in sigma], label="h = %g mm" % h)
         ax3b[1].plot(x, ratio, label="h = %g mm" % h)
@@ -339,9 +347,9 @@ def write(data):
     edges = {}  # h (mm): σ at the trailing and leading edge / mean σ, length with τ/σ > µ_k (mm)
     for h, (x, sigma, ratio) in onset_profiles.items():
         mean = sum(sigma) / len(sigma)
-        loaded = sum(1 for r in ratio if r > 0.17) * (x[1] - x[0])
-        L.append("| %g | %.2f | %.2f | %.1f |" % (h, sigma[0] / mean, sigma[-1] / mean, loaded))
+        loaded = sum(1 for r in ratio if r > MU_K) * (x[1] - x[0])
         edges[h] = (sigma[0] / mean, sigma[-1] / mean, loaded)
+        L.append("| %g | %.2f | %.2f | %.1f |" % ((h,) + edges[h]))
     L += ["", "*Agreement*: qualitative yes — both change strongly with h (%d to %d precursors, µ_s,macro %.3f "
           "to %.3f over h = 0–75 mm): the count falls as h rises from 0 to 20 mm, and pushing at the top corner "
           "gives many precursors and the highest µ_s,macro." % (min(counts), max(counts), min(macros), max(macros)),
@@ -370,12 +378,11 @@ def write(data):
         x = [float(r["x_m"]) * 1e3 for r in rows]
         ax4[0].plot(x, [-float(r["gauge_sigma_zz_Pa"]) / 1e6 for r in rows], label=label)
         ax4[1].plot(x, [float(r["gauge_tau_xz_Pa"]) / 1e6 for r in rows], label=label)
-        ax4[2].plot(x, [float(r["interface_shear_stress_Pa"]) / float(r["interface_normal_stress_Pa"])
-                        if float(r["interface_normal_stress_Pa"]) > 0 else math.nan for r in rows], label=label)
+        ax4[2].plot(x, [interface_ratio(r) for r in rows], label=label)
     for a, title in zip(ax4, ["-σ_zz at z_g = 2 mm (MPa)", "τ_xz at z_g = 2 mm (MPa)", "τ/σ at the interface"]):
         a.set_xlabel("x (mm)")
         a.set_title(title, fontsize=9)
-    ax4[2].axhline(0.4, color="gray", linestyle=":")
+    ax4[2].axhline(MU_S, color="gray", linestyle=":")
     ax4[0].legend(fontsize=6)
     fig4.tight_layout()
     fig4.savefig(os.path.join(FIG, "validation_stresses.png"), dpi=100)
@@ -390,8 +397,7 @@ def write(data):
         rows = [r for r in stress_rows if r["event"] == str(i) and r["phase"] == "onset"]
         gauge = [(float(r["gauge_tau_xz_Pa"]) / -float(r["gauge_sigma_zz_Pa"]), float(r["x_m"])) for r in rows
                  if float(r["gauge_sigma_zz_Pa"]) < 0]
-        face = [(float(r["interface_shear_stress_Pa"]) / float(r["interface_normal_stress_Pa"]), float(r["x_m"]))
-                for r in rows if float(r["interface_normal_stress_Pa"]) > 0]
+        face = [(interface_ratio(r), float(r["x_m"])) for r in rows if math.isfinite(interface_ratio(r))]
         g_max, f_max = max(gauge), max(face)
         L.append("| %d | %.3f | %.1f | %.3f | %.1f |" % (i, g_max[0], g_max[1] * 1e3, f_max[0], f_max[1] * 1e3))
     L += ["", "*Agreement*: at the interface the local ratio never exceeds µ_s = 0.4 (it cannot: a node slips "
@@ -430,12 +436,13 @@ def write(data):
         speeds_here = [p[1] for p in points]
         # Above c_L the fit sees nodes unsticking almost together, not a running front.
         running = [v for v in speeds_here if v < C_L]
+        median = float(numpy.median(running)) if running else None
         arrest = "-" if e["global"] == "1" else "%.0f" % points[-1][1]
         profile_rows.append("| %s | %.0f–%.0f | %.0f | %s | %.0f | %s |" % (
             label, points[0][0], points[-1][0], min(speeds_here),
-            "%.0f" % float(numpy.median(running)) if running else "-", max(speeds_here), arrest))
+            "%.0f" % median if running else "-", max(speeds_here), arrest))
         if e["global"] != "1" and running:
-            arrest_ratios.append((points[-1][1] / float(numpy.median(running)), points[-1][1] < C_R))
+            arrest_ratios.append((points[-1][1] / median, points[-1][1] < C_R))
     save_speed_figure(fig5a, ax5a, "x (mm)", "validation_front_profiles.png")
     L += ["Front speed profiles v_c(x) of the default run (speed from a sliding fit of first-unstick times over "
           "%d nodes):" % 5, "", "![v_c(x)](figures/validation_front_profiles.png)", "",

@@ -26,7 +26,7 @@ for path in sorted(pathlib.Path(sys.argv[1]).rglob("*.xml")):
     if bad:
         print(f"{path.name}: {bad} failed")
         for case in root.iter("testcase"):
-            for problem in list(case.findall("failure")) + list(case.findall("error")):
+            for problem in case.findall("failure") + case.findall("error"):
                 text = (problem.get("message") or "") + "\n" + (problem.text or "")
                 lines = [line for line in text.strip().splitlines() if line.strip()][:12]
                 print(f"  {case.get('classname', '')}.{case.get('name')}:")

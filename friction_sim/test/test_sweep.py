@@ -9,26 +9,29 @@ import shutil
 import sys
 import tempfile
 import unittest
+from unittest import mock
 
 import rosunit
+import yaml
 from catkin.find_in_workspaces import find_in_workspaces
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import sweep  # noqa: E402
 
-STATIC_COEFFICIENT = 0.4  # µ_s of friction_sim/scenes/single_block.yaml
+with open(os.path.join(ROOT, "friction_sim/scenes/single_block.yaml")) as scene:
+    STATIC_COEFFICIENT = yaml.safe_load(scene)["friction"]["static_coefficient"]
 
 
 class SweepTest(unittest.TestCase):
     def setUp(self):
         runners = find_in_workspaces(["libexec"], project="friction_sim", path="friction_run", first_match_only=True)
         self.assertTrue(runners, "friction_run is not built")
-        sweep.RUNNER = runners[0]
+        runner = mock.patch.object(sweep, "RUNNER", runners[0])
+        runner.start()
+        self.addCleanup(runner.stop)
         self.work = tempfile.mkdtemp(prefix="sweep_test_")
-
-    def tearDown(self):
-        shutil.rmtree(self.work)
+        self.addCleanup(shutil.rmtree, self.work)
 
     def write_sweep(self, normal_forces):
         path = os.path.join(self.work, "forces.yaml")
@@ -84,12 +87,9 @@ class SweepTest(unittest.TestCase):
             handle.write('#!/bin/sh\necho "$1" >> %s\nshift\n[ "$1" = "--" ] && shift\n'
                          'SHELL=/bin/sh; export SHELL\nexec /bin/sh -c "$*"\n' % calls)
         # Through /bin/sh, so that a temporary directory mounted noexec does not matter.
-        os.environ["PARALLEL_SSH"] = "/bin/sh " + stand_in
-        try:
+        with mock.patch.dict(os.environ, PARALLEL_SSH="/bin/sh " + stand_in):
             rows, failed = sweep.run(self.write_sweep("[1000, 2000, 3000, 4000]"), hosts="1/node1,1/node2",
                                      out=os.path.join(self.work, "out"))
-        finally:
-            del os.environ["PARALLEL_SSH"]
         self.assertEqual(failed, [])
         self.assert_onsets_follow_amontons(rows, [1000.0, 2000.0, 3000.0, 4000.0])
         with open(calls) as handle:
