@@ -29,7 +29,7 @@ class OneNode : public ::testing::Test {
     raw_.force = Vector::Constant(1, other);
     raw_.normal_force = Vector::Constant(1, normal);
     Vector force = raw_.force;
-    contact_.applyFriction(raw_, u_, force);
+    contact_.applyFriction(raw_, u_, 1.0, force);
     return force[0];
   }
   /// The state update after a force evaluation giving `other` and `normal` (N).
@@ -157,14 +157,15 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
   raw.normal_force = Vector::Constant(1, 10.0);
   u[0] = 3e-3;  // anchor spring force −3 N, within µ_s·N = 4 N
   force = raw.force;
-  contact.applyFriction(raw, u, force);
+  contact.applyFriction(raw, u, 0.5, force);  // a 2 kg block
   EXPECT_DOUBLE_EQ(contact.frictionForce(0), -3.0);
+  EXPECT_DOUBLE_EQ(force[0], (2.0 - 3.0) * 0.5);  // the block's acceleration, m/s²
   EXPECT_FALSE(contact.updateStates(u, v, 0.0, 1.0));
   EXPECT_DOUBLE_EQ(contact.anchorEnergy(u), 0.5 * k_t * 9e-6);
   u[0] = 5e-3;  // −5 N needed: unsticks
   EXPECT_TRUE(contact.updateStates(u, v, 0.0, 1.0));
   force = raw.force;
-  contact.applyFriction(raw, u, force);
+  contact.applyFriction(raw, u, 1.0, force);
   EXPECT_DOUBLE_EQ(contact.frictionForce(0), -kMuK * 10.0);
   contact.beginStep(u, v);
   contact.finishStep(u, v, 1e-3);
@@ -173,7 +174,7 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
   v[0] = -1.0;
   ASSERT_TRUE(contact.finishStep(u, v, 1e-3));
   force = raw.force;
-  contact.applyFriction(raw, u, force);
+  contact.applyFriction(raw, u, 1.0, force);
   EXPECT_NEAR(contact.frictionForce(0), -kMuK * 10.0, 1e-12);
 }
 

@@ -29,9 +29,10 @@ class ContactInterface {
   /// Sticks every node where it is, with no stored interfacial shear and slip measured from here.
   void reset(const Vector& u);
 
-  /// Adds the friction forces to `force`, which holds every other force on the degrees of freedom, and
-  /// records those other forces and the normal forces for the state updates.
-  void applyFriction(const ForceEvaluation& raw, const Vector& u, Vector& force);
+  /// `force` holds every force but friction on the degrees of freedom (N). Records its interface
+  /// entries and the normal forces for the state updates, and rewrites those entries as accelerations
+  /// (m/s²): (force + friction)·`inverse_mass`. The other entries are left to the caller.
+  void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force);
   /// After a change of state: recomputes the friction from the recorded forces and rewrites the
   /// interface entries of `acceleration` (m/s²) as (other force + friction)·`inverse_mass`.
   void reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration);
@@ -49,6 +50,8 @@ class ContactInterface {
   bool updateStates(Vector& u, Vector& v, double dt, double node_mass);
 
   int size() const { return static_cast<int>(state_.size()); }
+  /// The first interface degree of freedom; the others follow it contiguously.
+  int firstDof() const { return first_dof_; }
   ContactState state(int node) const { return state_[node]; }
   int slidingCount() const { return sliding_count_; }
   /// True when every node is stuck (none sliding, none detached).
@@ -86,8 +89,10 @@ class ContactInterface {
   void refreshCoefficients(int node);
   /// Forgets a node's load history (it has just stuck).
   void clearLoad(int node);
-  /// friction_ from the recorded forces: the branch-free form of the rules, so that it vectorises.
-  void computeFriction(const double* u);
+  /// Records the interface entries of `force_to_acceleration` (N, every force but friction) as the
+  /// other forces, computes friction_ from them, and overwrites those entries with accelerations (m/s²),
+  /// (other force + friction)·`inverse_mass`.
+  void accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration);
 
   std::unique_ptr<FrictionLaw> law_;
   std::vector<int> dofs_;

@@ -178,8 +178,11 @@ void Simulation::advance(double until) {
 
 double Simulation::acceleration(const Vector& u, const Vector& v, double t, Vector& a) {
   model_->evaluateInto(u, v, stage_.positionAfter(t - time_), a, evaluation_);
-  contact_.applyFriction(evaluation_, u, a);
-  a *= inverse_mass_;
+  contact_.applyFriction(evaluation_, u, inverse_mass_, a);
+  // The interface entries are accelerations already; scale the rest around them.
+  const Eigen::Index interface_end = contact_.firstDof() + contact_.size();
+  a.head(contact_.firstDof()) *= inverse_mass_;
+  a.tail(a.size() - interface_end) *= inverse_mass_;
   return evaluation_.viscous_power;
 }
 
