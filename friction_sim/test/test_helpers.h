@@ -1,7 +1,10 @@
 // Shared pieces of the core tests.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/model.h"
@@ -51,6 +54,42 @@ class FreeBody : public Dynamics {
  private:
   Model& model_;
   ForceEvaluation evaluation_;
+};
+
+/// Records what the evaluation asks of its hooks: each range is displaced when prepared (so a read
+/// before preparation would change the forces), and its forces are copied when finished.
+class RecordingHooks : public StripHooks {
+ public:
+  RecordingHooks(Vector& u, const Vector& shift, const Vector& force)
+      : u_(u), shift_(shift), force_(force), prepared_(u.size(), 0), finished_(u.size(), 0),
+        forces_at_finish_(Vector::Constant(u.size(), std::nan(""))) {}
+  void prepare(int first, int end) override {
+    for (int i = first; i < end; ++i) {
+      ++prepared_[i];
+      untouched_force_at_prepare_ = untouched_force_at_prepare_ && std::isnan(force_[i]);
+      u_[i] += shift_[i];
+    }
+  }
+  void finish(int first, int end) override {
+    for (int i = first; i < end; ++i) {
+      ++finished_[i];
+      forces_at_finish_[i] = force_[i];
+    }
+  }
+  bool eachOnce() const {
+    return std::all_of(prepared_.begin(), prepared_.end(), [](int n) { return n == 1; }) &&
+           std::all_of(finished_.begin(), finished_.end(), [](int n) { return n == 1; });
+  }
+  bool untouchedForceAtPrepare() const { return untouched_force_at_prepare_; }
+  const Vector& forcesAtFinish() const { return forces_at_finish_; }
+
+ private:
+  Vector& u_;
+  const Vector& shift_;
+  const Vector& force_;
+  std::vector<int> prepared_, finished_;
+  Vector forces_at_finish_;
+  bool untouched_force_at_prepare_ = true;
 };
 
 }  // namespace friction::testing

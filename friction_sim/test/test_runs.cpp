@@ -182,5 +182,22 @@ TEST(StageProgram, BadCommandsAreRefusedAndChangeNothing) {
   EXPECT_DOUBLE_EQ(stage.velocity(), -1e-3);
 }
 
+TEST(SimulationStrips, AccelerationsFinishOnceEachWithFrictionOnTheInterface) {
+  Simulation simulation(testing::coarseSliderScene());
+  for (int step = 0; step < 200; ++step) simulation.step();
+  Vector u = simulation.displacements();
+  const Vector v = simulation.velocities(), no_shift = Vector::Zero(u.size());
+  Vector plain, strips = Vector::Constant(u.size(), std::nan(""));
+  simulation.acceleration(u, v, simulation.time(), plain);
+  testing::RecordingHooks hooks(u, no_shift, strips);
+  simulation.accelerationInStrips(u, v, simulation.time(), strips, hooks);
+  EXPECT_TRUE(hooks.eachOnce());
+  EXPECT_TRUE(hooks.untouchedForceAtPrepare());
+  // What each range holds when it is finished are its final accelerations, friction included.
+  EXPECT_TRUE((hooks.forcesAtFinish().array() == plain.array()).all());
+  EXPECT_TRUE((strips.array() == plain.array()).all());
+  EXPECT_GT(std::abs(simulation.contact().frictionForce(0)), 0.0);
+}
+
 }  // namespace
 }  // namespace friction

@@ -16,6 +16,9 @@ class Dynamics {
   /// Writes the acceleration at (u, v, t) into `a`; returns the power (W) dissipated by the
   /// velocity-dependent forces there.
   virtual double acceleration(const Vector& u, const Vector& v, double t, Vector& a) = 0;
+  /// acceleration() with the caller's passes over the state fused in strip by strip (StripHooks; a
+  /// range is finished once its accelerations are final). By default one strip.
+  virtual double accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks);
 };
 
 class Integrator {
@@ -29,6 +32,7 @@ class Integrator {
 };
 
 /// Kick–drift–kick velocity Verlet; velocity-dependent forces are evaluated with the half-step velocity.
+/// Its passes run inside the force evaluation's strips (Dynamics::accelerationInStrips).
 class VelocityVerlet : public Integrator {
  public:
   double step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,

@@ -36,6 +36,9 @@ class Lattice2D : public Model {
 
   void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                     ForceEvaluation& out) const override;
+  /// Strips of whole rows; the external forces on a row are added before it is finished.
+  void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                        ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const override;
   double elasticEnergy(const Vector& u, double stage_position) const override;
   double externalWork(const Vector& u_from, const Vector& u_to) const override;
   SparseMatrix stiffnessMatrix() const override;

@@ -37,6 +37,20 @@ struct ForceEvaluation {
   double viscous_power = 0.0;  ///< W, dissipated by the pair damping at the given velocities
 };
 
+/// Lets a caller fuse its own passes over the state into a force evaluation, strip by strip, while the
+/// strip is in cache: at 10⁶ nodes separate passes are bound by memory bandwidth. Each hook gets a range
+/// [first, end) of degrees of freedom; by default they do nothing.
+class StripHooks {
+ public:
+  virtual ~StripHooks() = default;
+  /// Called before the evaluation reads the state of these degrees of freedom or writes their forces:
+  /// the caller may still change them here (the integrator's drift).
+  virtual void prepare(int /*first*/, int /*end*/) {}
+  /// Called once the forces on these degrees of freedom are final and their velocities will not be
+  /// read again (the integrator's closing kick).
+  virtual void finish(int /*first*/, int /*end*/) {}
+};
+
 /// Stress tensor components at the gauge height, at the gauge positions (tension positive).
 struct GaugeStresses {
   std::vector<double> sigma_xx;  ///< Pa
@@ -63,6 +77,10 @@ class Model {
   /// is left alone). The integrators' hot loop passes its acceleration vector as `force`.
   virtual void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                             ForceEvaluation& out) const = 0;
+  /// evaluateInto() with `hooks` called on strips of about `strip_nodes` nodes; every degree of freedom is
+  /// prepared once and finished once. By default one strip: everything prepared, evaluated, finished.
+  virtual void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                                ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const;
   /// The same, with the forces in `out.force`.
   void evaluate(const Vector& u, const Vector& v, double stage_position, ForceEvaluation& out) const {
     evaluateInto(u, v, stage_position, out.force, out);

@@ -81,6 +81,9 @@ class Simulation : public Dynamics {
   std::uint64_t stateHash() const;
 
   double acceleration(const Vector& u, const Vector& v, double t, Vector& a) override;
+  /// The forces in strips of kStripNodes nodes, each turned into accelerations before the caller's
+  /// finish; the interface is finished last, once its friction is known.
+  double accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) override;
 
  private:
   void relaxToLoadedEquilibrium();

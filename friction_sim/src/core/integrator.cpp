@@ -8,20 +8,49 @@
 
 namespace friction {
 
+double Dynamics::accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) {
+  const int size = static_cast<int>(a.size());
+  hooks.prepare(0, size);
+  const double power = acceleration(u, v, t, a);
+  hooks.finish(0, size);
+  return power;
+}
+
+namespace {
+/// Velocity Verlet's passes over the state, run by the force evaluation strip by strip. A range is
+/// prepared while its accelerations are still those of the step's start.
+class VerletPasses : public StripHooks {
+ public:
+  VerletPasses(Vector& u, Vector& v, const Vector& a, double dt)
+      : displacement_(u.data()), velocity_(v.data()), acceleration_(a.data()), dt_(dt), half_dt_(0.5 * dt) {}
+  void prepare(int first, int end) override { kickAndDrift(end - first, half_dt_, dt_, acceleration_ + first, velocity_ + first, displacement_ + first); }
+  void finish(int first, int end) override { kick(end - first, half_dt_, acceleration_ + first, velocity_ + first); }
+
+ private:
+  // Static, with restrict parameters: GCC honours restrict only on parameters.
+  static void kickAndDrift(int count, double half_dt, double dt, const double* __restrict acceleration,
+                           double* __restrict velocity, double* __restrict displacement) {
+    for (int i = 0; i < count; ++i) {
+      velocity[i] += half_dt * acceleration[i];
+      displacement[i] += dt * velocity[i];
+    }
+  }
+  static void kick(int count, double half_dt, const double* __restrict acceleration, double* __restrict velocity) {
+    for (int i = 0; i < count; ++i) velocity[i] += half_dt * acceleration[i];
+  }
+
+  double* displacement_;
+  double* velocity_;
+  const double* acceleration_;
+  double dt_, half_dt_;
+};
+}  // namespace
+
 double VelocityVerlet::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
                            double dt) {
-  // Kick and drift in one pass over the state.
-  double* __restrict velocity = v.data();
-  double* __restrict displacement = u.data();
-  const double* __restrict acceleration = a.data();
-  const double half_dt = 0.5 * dt;
-  for (Eigen::Index i = 0; i < u.size(); ++i) {
-    velocity[i] += half_dt * acceleration[i];
-    displacement[i] += dt * velocity[i];
-  }
+  VerletPasses passes(u, v, a, dt);
   // Midpoint rule: the half-step velocity is the step's mean velocity.
-  power = dynamics.acceleration(u, v, t + dt, a);
-  v.noalias() += 0.5 * dt * a;
+  power = dynamics.accelerationInStrips(u, v, t + dt, a, passes);
   return power * dt;
 }
 

@@ -127,6 +127,12 @@ void bondRow(const NodeArrays& nodes, int a0, int b0, int count, double rest_x, 
 
 void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                              ForceEvaluation& out) const {
+  StripHooks none;
+  evaluateInStrips(u, v, stage_position, force, out, none, n_);
+}
+
+void Lattice2D::evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                                 ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const {
   force.resize(2 * n_);
   out.normal_force.resize(nx_);
   double* fx = force.data();
@@ -135,10 +141,21 @@ void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_posi
   const double* uz = u.data() + n_;
   const NodeArrays nodes{ux, uz, v.data(), v.data() + n_};
   auto bonds = geometric_ ? &bondRow<true> : &bondRow<false>;
+  // Strips are whole rows: both dofs of rows [first_row, end_row).
+  auto prepare = [&](int first_row, int end_row) {
+    hooks.prepare(first_row * nx_, end_row * nx_);
+    hooks.prepare(n_ + first_row * nx_, n_ + end_row * nx_);
+  };
+  auto finish = [&](int first_row, int end_row) {
+    hooks.finish(first_row * nx_, end_row * nx_);
+    hooks.finish(n_ + first_row * nx_, n_ + end_row * nx_);
+  };
+  const int rows_per_strip = std::max(1, strip_nodes / nx_);
+  int prepared_rows = 0, finished_rows = 0;
   // Row by row: first every bond of the row (contiguous runs of nodes, so the loops vectorise), then
-  // each node's force gathered once from its eight bonds, half of them kept from the row below.
-  // Buffer index p holds the bond whose lower-index node is at column p − 1 (p − 2 for the
-  // antidiagonal); the padding entries stay zero.
+  // each node's force gathered once from its eight bonds, half of them kept from the row below, then
+  // the external forces on the row. Buffer index p holds the bond whose lower-index node is at column
+  // p − 1 (p − 2 for the antidiagonal); the padding entries stay zero.
   const BondFamily& horizontal = families_[0];
   const BondFamily& vertical = families_[1];
   const BondFamily& diagonal = families_[2];
@@ -149,7 +166,16 @@ void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_posi
   };
   std::fill(column_power_.begin(), column_power_.end(), 0.0);
   below_.clear();
+  double normal_sum_top = 0.0, shear = 0.0;
+  std::size_t next_pushed = 0;
   for (int j = 0; j < nz_; ++j) {
+    // The bonds of row j read rows j and j + 1.
+    const int rows_needed = std::min(nz_, j + 2);
+    if (prepared_rows < rows_needed) {
+      const int end_row = std::min(nz_, std::max(rows_needed, prepared_rows + rows_per_strip));
+      prepare(prepared_rows, end_row);
+      prepared_rows = end_row;
+    }
     const int row = j * nx_, next = row + nx_;
     run(horizontal, row, row + 1, nx_ - 1, horizontal_x_.data() + 1, horizontal_z_.data() + 1);
     if (j + 1 < nz_) {
@@ -174,36 +200,41 @@ void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_posi
            upward_.antidiagonal_z.data(), below_.vertical_z.data(), below_.diagonal_z.data(),
            below_.antidiagonal_z.data(), fz + row);
     std::swap(upward_, below_);
+    if (j == 0) {
+      for (int i = 0; i < nx_; ++i) {
+        const double normal = kf_ * std::max(0.0, -uz[i]);
+        out.normal_force[i] = normal;
+        fz[i] += normal;
+      }
+    }
+    if (j == nz_ - 1) {
+      for (int i = 0; i < nx_; ++i) {
+        const int top = nodeIndex(i, j);
+        if (mattress_) {
+          const double spring = topSpringForce(u, i);
+          fz[top] += spring;
+          fx[top] += mattress_kx_per_node_ * (top_anchor_x_[i] - ux[top]);
+          normal_sum_top -= spring;
+        } else {
+          fz[top] -= normal_force_ / nx_;
+        }
+      }
+    }
+    for (; pusher_connected_ && next_pushed < pushed_rows_.size() && pushed_rows_[next_pushed] == j; ++next_pushed) {
+      const int node = nodeIndex(0, j);
+      const double pusher_force = pusher_k_per_row_ * (stage_position + pusher_offset_[next_pushed] - ux[node]);
+      fx[node] += pusher_force;
+      shear += pusher_force;
+    }
+    if (j + 1 - finished_rows >= rows_per_strip || j == nz_ - 1) {
+      finish(finished_rows, j + 1);
+      finished_rows = j + 1;
+    }
   }
-  const double viscous_power =
+  out.viscous_power =
       Eigen::Map<const Eigen::ArrayXd>(column_power_.data(), static_cast<Eigen::Index>(column_power_.size())).sum();
-  double normal_sum_top = 0.0;
-  for (int i = 0; i < nx_; ++i) {
-    const double normal = kf_ * std::max(0.0, -uz[i]);
-    out.normal_force[i] = normal;
-    fz[i] += normal;
-    const int top = nodeIndex(i, nz_ - 1);
-    if (mattress_) {
-      const double spring = topSpringForce(u, i);
-      fz[top] += spring;
-      fx[top] += mattress_kx_per_node_ * (top_anchor_x_[i] - ux[top]);
-      normal_sum_top -= spring;
-    } else {
-      fz[top] -= normal_force_ / nx_;
-    }
-  }
   out.normal_load = mattress_ ? normal_sum_top : normal_force_;
-  double shear = 0.0;
-  if (pusher_connected_) {
-    for (std::size_t r = 0; r < pushed_rows_.size(); ++r) {
-      const int node = nodeIndex(0, pushed_rows_[r]);
-      const double force = pusher_k_per_row_ * (stage_position + pusher_offset_[r] - ux[node]);
-      fx[node] += force;
-      shear += force;
-    }
-  }
   out.shear_force = shear;
-  out.viscous_power = viscous_power;
 }
 
 double Lattice2D::elasticEnergy(const Vector& u, double stage_position) const {

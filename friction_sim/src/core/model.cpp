@@ -5,6 +5,13 @@
 
 namespace friction {
 
+void Model::evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                             ForceEvaluation& out, StripHooks& hooks, int /*strip_nodes*/) const {
+  hooks.prepare(0, dofCount());
+  evaluateInto(u, v, stage_position, force, out);
+  hooks.finish(0, dofCount());
+}
+
 std::vector<int> Model::blockedDofsDuringLoading() const {
   std::vector<int> dofs;
   for (int node = 0; node < interfaceNodeCount(); ++node) dofs.push_back(interfaceDof(node));

@@ -176,13 +176,49 @@ void Simulation::advance(double until) {
   step();
 }
 
+namespace {
+/// About 4·10³ nodes: the strip's displacements, velocities and accelerations (≈ 200 kB) stay in the
+/// L2 cache between the force evaluation and the integrator's passes.
+constexpr int kStripNodes = 4096;
+
+/// Turns each finished strip's forces into accelerations before passing it on; the interface's
+/// entries wait for friction.
+class AccelerationStrips : public StripHooks {
+ public:
+  AccelerationStrips(StripHooks& caller, Vector& a, double inverse_mass, int interface_begin, int interface_end)
+      : caller_(caller), a_(a), inverse_mass_(inverse_mass), interface_begin_(interface_begin),
+        interface_end_(interface_end) {}
+  void prepare(int first, int end) override { caller_.prepare(first, end); }
+  void finish(int first, int end) override {
+    finishOutsideInterface(first, std::min(end, interface_begin_));
+    finishOutsideInterface(std::max(first, interface_end_), end);
+  }
+
+ private:
+  void finishOutsideInterface(int first, int end) {
+    if (first >= end) return;
+    a_.segment(first, end - first) *= inverse_mass_;
+    caller_.finish(first, end);
+  }
+
+  StripHooks& caller_;
+  Vector& a_;
+  double inverse_mass_;
+  int interface_begin_, interface_end_;
+};
+}  // namespace
+
 double Simulation::acceleration(const Vector& u, const Vector& v, double t, Vector& a) {
-  model_->evaluateInto(u, v, stage_.positionAfter(t - time_), a, evaluation_);
+  StripHooks none;
+  return accelerationInStrips(u, v, t, a, none);
+}
+
+double Simulation::accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) {
+  const int interface_begin = contact_.firstDof(), interface_end = interface_begin + contact_.size();
+  AccelerationStrips strips(hooks, a, inverse_mass_, interface_begin, interface_end);
+  model_->evaluateInStrips(u, v, stage_.positionAfter(t - time_), a, evaluation_, strips, kStripNodes);
   contact_.applyFriction(evaluation_, u, inverse_mass_, a);
-  // The interface entries are accelerations already; scale the rest around them.
-  const Eigen::Index interface_end = contact_.firstDof() + contact_.size();
-  a.head(contact_.firstDof()) *= inverse_mass_;
-  a.tail(a.size() - interface_end) *= inverse_mass_;
+  hooks.finish(interface_begin, interface_end);
   return evaluation_.viscous_power;
 }
 
