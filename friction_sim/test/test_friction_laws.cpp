@@ -163,6 +163,8 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
   EXPECT_FALSE(contact.updateStates(u, v, 0.0, 1.0));
   EXPECT_DOUBLE_EQ(contact.anchorEnergy(u), 0.5 * k_t * 9e-6);
   u[0] = 5e-3;  // −5 N needed: unsticks
+  force = raw.force;
+  contact.applyFriction(raw, u, 1.0, force);
   EXPECT_TRUE(contact.updateStates(u, v, 0.0, 1.0));
   force = raw.force;
   contact.applyFriction(raw, u, 1.0, force);

@@ -42,7 +42,8 @@ class ContactInterface {
   /// After the integrator's step: stops nodes whose velocity passed through zero at the interpolated
   /// crossing, accounts friction dissipation and slip. Returns true if any node re-stuck.
   bool finishStep(Vector& u, Vector& v, double dt);
-  /// After the last force evaluation of a step of length dt (and its applyFriction): loss and return of
+  /// After the last force evaluation of a step of length dt and its applyFriction at these displacements
+  /// (the stuck nodes' loads are its friction forces): loss and return of
   /// contact, unsticking. A node that crossed its threshold at a fraction s of the step is given the
   /// motion it would have made sliding for the rest of the step, (1 − s)·dt, so that slip starts on time
   /// rather than up to a step late. Returns true if any node changed state (its friction must then be

@@ -80,17 +80,16 @@ inline double frictionOf(double stuck_weight, double holding, double sliding_coe
   return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
 }
 /// The state update's pass over every node, branch-free so that it vectorises (restrict holds for
-/// parameters): the force needed to hold each node (the anchor spring's, or with k_T = 0 the rigid
-/// reaction) and its threshold µ_s·N. Returns how many nodes need one of the state rules: a stuck node
+/// parameters): the force holding each node, its friction from the last frictionPass (for a stuck node
+/// the anchor spring's force, or with k_T = 0 the rigid reaction), and its threshold µ_s·N. Returns how many nodes need one of the state rules: a stuck node
 /// in contact over its threshold, a node losing contact or a detached node regaining it.
-int loadPass(int n, double k_t, const double* __restrict x, const double* __restrict anchor,
-             const double* __restrict other, const double* __restrict normal, const double* __restrict mu,
-             const double* __restrict stuck, const double* __restrict sign, double* __restrict held,
-             double* __restrict threshold) {
-  const double rigid_weight = k_t > 0.0 ? 0.0 : 1.0;
+int loadPass(int n, const double* __restrict friction, const double* __restrict normal,
+             const double* __restrict mu, const double* __restrict stuck, const double* __restrict sign,
+             double* __restrict held, double* __restrict threshold) {
   int attention = 0;
   for (int node = 0; node < n; ++node) {
-    held[node] = std::abs(holdingForce(k_t, rigid_weight, anchor[node], x[node], other[node]));
+    // A stuck node's friction is the force that holds it.
+    held[node] = std::abs(friction[node]);
     threshold[node] = mu[node] * normal[node];
     // 0/1 flags as doubles, so that every lane of the loop has the same width.
     const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
@@ -213,8 +212,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
   // needs one of the rules below. Usually none does, and the step ends here.
   held_force_.swap(previous_held_force_);
   threshold_.swap(previous_threshold_);
-  const int attention = loadPass(n, k_t_, u.data() + first_dof_, anchor_.data(), other_force_.data(),
-                                 normal_.data(), static_coefficient_.data(), stuck_weight_.data(),
+  const int attention = loadPass(n, friction_.data(), normal_.data(), static_coefficient_.data(), stuck_weight_.data(),
                                  sliding_sign_.data(), held_force_.data(), threshold_.data());
   if (attention == 0) return false;
   bool changed = false;
