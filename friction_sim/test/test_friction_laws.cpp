@@ -24,7 +24,8 @@ class OneNode : public ::testing::Test {
     scene.chain.blocks = 1;
     return scene;
   }
-  /// Friction for a tangential force `other` (N) and normal force `normal` (N); returns the net force.
+  /// Friction for a tangential force `other` (N) and normal force `normal` (N); returns the net force
+  /// (the acceleration of a 1 kg block).
   double net(double other, double normal) {
     raw_.force = Vector::Constant(1, other);
     raw_.normal_force = Vector::Constant(1, normal);
@@ -160,7 +161,7 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
   contact.applyFriction(raw, u, 0.5, force);  // a 2 kg block
   EXPECT_DOUBLE_EQ(contact.frictionForce(0), -3.0);
   EXPECT_DOUBLE_EQ(force[0], (2.0 - 3.0) * 0.5);  // the block's acceleration, m/s²
-  EXPECT_FALSE(contact.updateStates(u, v, 0.0, 1.0));
+  EXPECT_FALSE(contact.updateStates(u, v, 0.0, 2.0));
   EXPECT_DOUBLE_EQ(contact.anchorEnergy(u), 0.5 * k_t * 9e-6);
   u[0] = 5e-3;  // −5 N needed: unsticks
   force = raw.force;

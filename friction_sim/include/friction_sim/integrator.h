@@ -24,8 +24,8 @@ class Dynamics {
 class Integrator {
  public:
   virtual ~Integrator() = default;
-  /// Advances (u, v) from t to t + dt. On entry `a` and `power` are the acceleration and dissipated
-  /// power at the start of the step; on exit, at its end. Returns the energy (J) dissipated by the
+  /// Advances (u, v) from t to t + dt. On entry `a` (sized like u) and `power` are the acceleration and
+  /// dissipated power at the start of the step; on exit, at its end. Returns the energy (J) dissipated by the
   /// velocity-dependent forces during the step, integrated with the scheme's own quadrature.
   virtual double step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
                       double dt) = 0;

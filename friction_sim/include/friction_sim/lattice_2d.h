@@ -85,7 +85,7 @@ class Lattice2D : public Model {
   double pusher_k_per_row_;
   std::vector<double> pusher_offset_;  ///< m, u_x of each pushed node when the pusher was connected
   bool pusher_connected_ = true;
-  /// Work space of evaluateInto(): the bond forces (N, on the bond's lower-index node) of the current
+  /// Work space of the force sweep: the bond forces (N, on the bond's lower-index node) of the current
   /// row, along x (`horizontal`) and up to the next row (`upward`), and of the row below, zero-padded so
   /// that the node loop needs no edge cases; and the viscous power (W) summed per column.
   struct RowBonds {

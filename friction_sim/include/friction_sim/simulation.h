@@ -81,8 +81,8 @@ class Simulation : public Dynamics {
   std::uint64_t stateHash() const;
 
   double acceleration(const Vector& u, const Vector& v, double t, Vector& a) override;
-  /// The forces in strips of kStripNodes nodes, each turned into accelerations before the caller's
-  /// finish; the interface is finished last, once its friction is known.
+  /// The forces in strips of about 4096 nodes (their state stays in the L2 cache), each turned into
+  /// accelerations before the caller's finish; the interface is finished last, once its friction is known.
   double accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) override;
 
  private:

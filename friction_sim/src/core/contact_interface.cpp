@@ -80,8 +80,9 @@ inline double frictionOf(double stuck_weight, double holding, double sliding_coe
   return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
 }
 /// The state update's pass over every node, branch-free so that it vectorises (restrict holds for
-/// parameters): the force holding each node, its friction from the last frictionPass (for a stuck node
-/// the anchor spring's force, or with k_T = 0 the rigid reaction), and its threshold µ_s·N. Returns how many nodes need one of the state rules: a stuck node
+/// parameters): the load each stuck node carries, its friction from the last frictionPass (the anchor
+/// spring's force, or with k_T = 0 the rigid reaction), and its threshold µ_s·N. The other nodes'
+/// loads are never read: a node that sticks again starts with a cleared load. Returns how many nodes need one of the state rules: a stuck node
 /// in contact over its threshold, a node losing contact or a detached node regaining it.
 int loadPass(int n, const double* __restrict friction, const double* __restrict normal,
              const double* __restrict mu, const double* __restrict stuck, const double* __restrict sign,
@@ -237,14 +238,14 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
       continue;
     }
     if (state_[node] != ContactState::Stuck || held_force_[node] <= threshold_[node]) continue;
-    const double needed = holdingForce(k_t_, k_t_ > 0.0 ? 0.0 : 1.0, anchor_[node], u[dof], other_force_[node]);
     const double ratio = held_force_[node] / threshold_[node];
     const double previous_ratio = previous_held_force_[node] / previous_threshold_[node];
     transition_fraction_[node] =
         previous_ratio < 1.0 ? std::clamp((1.0 - previous_ratio) / (ratio - previous_ratio), 0.0, 1.0) : 0.0;
     // The spring energy of an elastic anchor is released into the slip.
     dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
-    startSliding(node, needed > 0.0 ? -1 : 1);
+    // It slides opposite to the friction that held it.
+    startSliding(node, friction_[node] > 0.0 ? -1 : 1);
     const double late = (1.0 - transition_fraction_[node]) * dt;
     const double sliding_friction = -sliding_coefficient_[node] * normal * sliding_sign_[node];
     const double acceleration = (other_force_[node] + sliding_friction) / node_mass;

@@ -9,7 +9,7 @@
 namespace friction {
 
 double Dynamics::accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) {
-  const int size = static_cast<int>(a.size());
+  const int size = static_cast<int>(u.size());
   hooks.prepare(0, size);
   const double power = acceleration(u, v, t, a);
   hooks.finish(0, size);
@@ -23,7 +23,9 @@ class VerletPasses : public StripHooks {
  public:
   VerletPasses(Vector& u, Vector& v, const Vector& a, double dt)
       : displacement_(u.data()), velocity_(v.data()), acceleration_(a.data()), dt_(dt), half_dt_(0.5 * dt) {}
-  void prepare(int first, int end) override { kickAndDrift(end - first, half_dt_, dt_, acceleration_ + first, velocity_ + first, displacement_ + first); }
+  void prepare(int first, int end) override {
+    kickAndDrift(end - first, half_dt_, dt_, acceleration_ + first, velocity_ + first, displacement_ + first);
+  }
   void finish(int first, int end) override { kick(end - first, half_dt_, acceleration_ + first, velocity_ + first); }
 
  private:
