@@ -26,12 +26,18 @@ inline Scene singleBlockScene(IntegratorKind scheme, double stage_speed, double 
   return scene;
 }
 
+/// The default slider (pmma_2d) at nodes_x × nodes_z nodes: the same physical slider at another spacing.
+inline Scene pmmaScene(int nodes_x, int nodes_z) {
+  Scene scene = loadScene(scenePath("pmma_2d"));
+  scene.lattice.nodes_x = nodes_x;
+  scene.lattice.nodes_z = nodes_z;
+  return scene;
+}
+
 /// A coarse 2D slider (29 × 16 nodes, l = 5 mm) driven ten times faster than the default, so that a
 /// whole run to the first global event takes about a second.
 inline Scene coarseSliderScene(bool fast_forward = false) {
-  Scene scene = loadScene(scenePath("pmma_2d"));
-  scene.lattice.nodes_x = 29;
-  scene.lattice.nodes_z = 16;
+  Scene scene = pmmaScene(29, 16);
   scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3}};
   scene.integrator.time_step = 4e-7;
   scene.integrator.fast_forward = fast_forward;

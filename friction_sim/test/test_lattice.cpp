@@ -207,9 +207,7 @@ TEST(LatticeSpringForm, LinearisedForcesAgreeWithGeometricAtSmallStrain) {
 
 /// The loaded slider at 21 × 11 nodes, with the top load and pusher of `variant`.
 Scene stripScene(int variant) {
-  Scene scene = loadScene(testing::scenePath("pmma_2d"));
-  scene.lattice.nodes_x = 21;
-  scene.lattice.nodes_z = 11;
+  Scene scene = testing::pmmaScene(21, 11);
   if (variant == 1) {
     // A spring mattress that holds the top row in x as well, and a pusher band up to the top row.
     scene.load.top = TopLoadKind::SpringMattress;

@@ -25,8 +25,10 @@ class SceneError : public ConfigError {
 /// a large lattice's spectrum is not estimated twice.
 Scene parseScene(const std::string& yaml_text, const Scene& base = Scene{}, double* stability_limit = nullptr);
 
-/// Reads and parses a scene file (see parseScene).
-Scene loadScene(const std::string& path, double* stability_limit = nullptr);
+/// Reads and parses a scene file (see parseScene), with `overrides` (as for overrideScene) applied
+/// before the one validation.
+Scene loadScene(const std::string& path, const std::vector<std::pair<std::string, std::string>>& overrides = {},
+                double* stability_limit = nullptr);
 
 /// The scene with fields replaced: each override is a dotted key ("pusher.height") and a YAML value
 /// ("0.01"). The result is parsed and validated like a file (see parseScene). Throws SceneError.

@@ -184,8 +184,9 @@ Vector GridMultigrid::solve(const Vector& rhs, double relative_tolerance) const 
   Vector preconditioned = cycle(0, residual);
   Vector direction = preconditioned;
   double along = residual.dot(preconditioned);
+  Vector image(rhs.size());
   for (int iteration = 1; iteration <= kMaxIterations; ++iteration) {
-    const Vector image = matrix * direction;
+    image.noalias() = matrix * direction;
     const double step = along / direction.dot(image);
     x += step * direction;
     residual -= step * image;

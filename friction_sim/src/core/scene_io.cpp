@@ -207,9 +207,10 @@ std::string readTextFile(const std::string& path, std::vector<std::string>& prob
   return text.str();
 }
 
-Scene parseScene(const std::string& yaml_text, const Scene& base, double* stability_limit) {
+namespace {
+/// The fields of `yaml_text` read over `base`; problems are collected, the result is not validated.
+Scene readFields(const std::string& yaml_text, const Scene& base, std::vector<std::string>& problems) {
   Scene scene = base;
-  std::vector<std::string> problems;
   YAML::Node root;
   try {
     root = loadMapping(yaml_text, "scene");
@@ -219,21 +220,18 @@ Scene parseScene(const std::string& yaml_text, const Scene& base, double* stabil
   YamlFieldReader reader(root, problems);
   visitScene(scene, reader);
   reader.rejectUnknownKeys();
-  // Validate even after parse problems so that one refusal lists everything wrong with the file.
+  return scene;
+}
+
+/// Validates even after parse problems, so that one refusal lists everything wrong.
+Scene validated(const Scene& scene, std::vector<std::string>& problems, double* stability_limit) {
   for (auto& problem : validateScene(scene, stability_limit)) problems.push_back(std::move(problem));
   if (!problems.empty()) throw SceneError(problems);
   return scene;
 }
 
-Scene loadScene(const std::string& path, double* stability_limit) {
-  std::vector<std::string> problems;
-  const std::string text = readTextFile(path, problems);
-  if (!problems.empty()) throw SceneError(problems);
-  return parseScene(text, Scene{}, stability_limit);
-}
-
-Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides,
-                    double* stability_limit) {
+/// The overrides as one YAML mapping ("pusher.height" → pusher: {height: ...}). Throws SceneError.
+std::string overridesYaml(const std::vector<std::pair<std::string, std::string>>& overrides) {
   YAML::Node root(YAML::NodeType::Map);
   std::vector<std::string> problems;
   for (const auto& [key, value] : overrides) {
@@ -256,7 +254,30 @@ Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, 
     }
   }
   if (!problems.empty()) throw SceneError(problems);
-  return parseScene(YAML::Dump(root), base, stability_limit);
+  return YAML::Dump(root);
+}
+}  // namespace
+
+Scene parseScene(const std::string& yaml_text, const Scene& base, double* stability_limit) {
+  std::vector<std::string> problems;
+  const Scene scene = readFields(yaml_text, base, problems);
+  return validated(scene, problems, stability_limit);
+}
+
+Scene loadScene(const std::string& path, const std::vector<std::pair<std::string, std::string>>& overrides,
+                double* stability_limit) {
+  std::vector<std::string> problems;
+  const std::string text = readTextFile(path, problems);
+  if (!problems.empty()) throw SceneError(problems);
+  Scene scene = readFields(text, Scene{}, problems);
+  // Validated once, with the overrides applied: validation estimates a large lattice's spectrum.
+  if (!overrides.empty()) scene = readFields(overridesYaml(overrides), scene, problems);
+  return validated(scene, problems, stability_limit);
+}
+
+Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides,
+                    double* stability_limit) {
+  return parseScene(overridesYaml(overrides), base, stability_limit);
 }
 
 std::string sceneToYaml(const Scene& scene) {

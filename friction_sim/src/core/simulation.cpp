@@ -105,6 +105,7 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   if (!(span > dt_)) return false;
   double jump = span;
   Vector along = Vector::Zero(u_.size());  // du/dX_s along the equilibrium
+  Vector path_velocity = Vector::Zero(u_.size());  // m/s, every free node moves with the stage
   bool stops_at_threshold = false;
   if (speed != 0.0) {
     // The pusher's force per unit stage travel, and the free nodes' response to it.
@@ -116,7 +117,7 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
     // Friction needed and normal force of every stuck node are affine in the stage position. Along the
     // path every free node moves at speed·along, and the pair damping's force on the stuck nodes
     // counts towards their thresholds, as it does once the dynamics takes over.
-    const Vector path_velocity = speed * along;
+    path_velocity = speed * along;
     const double probe = 1e-6 * model_->nodeSpacing();
     model_->evaluate(u_, path_velocity, stage_.position(), here);
     model_->evaluate(u_ + probe * along, path_velocity, stage_.position() + probe, moved);
@@ -156,8 +157,7 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   stage_.advance(jump);
   time_ += jump;
   pinned_solver_->solve(*model_, u_, stage_end);
-  // Every free node moves with the stage along the equilibrium.
-  v_ = speed * along;
+  v_.swap(path_velocity);
   refreshAfterStaticChange();
   // Round-off may land a node just past its threshold: then its slip starts here.
   detector_.update(time_, 0.0, contact_, u_, {evaluation_.shear_force, evaluation_.shear_force, evaluation_.normal_load});

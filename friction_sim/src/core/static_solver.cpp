@@ -43,12 +43,10 @@ SparseMatrix freeStiffness(const Model& model, const std::vector<int>& position_
   return stiffness;
 }
 
-/// The model's dofs as a grid of nodes; components = 0 if they are not laid out as one.
+/// The model's dofs as a grid of nodes (every model is one: the chain's is n × 1).
 GridLayout gridLayoutOf(const Model& model) {
   const auto shape = model.gridShape();
-  const int nodes = shape[0] * shape[1];
-  if (nodes <= 0 || model.dofCount() % nodes != 0) return {shape[0], shape[1], 0};
-  return {shape[0], shape[1], model.dofCount() / nodes};
+  return {shape[0], shape[1], model.dofCount() / (shape[0] * shape[1])};
 }
 }  // namespace
 
@@ -70,11 +68,10 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
   const GridLayout layout = gridLayoutOf(model);
   if (method == StaticMethod::kAuto) {
     // A chain's factor has no fill-in: only a 2D grid gains from multigrid.
-    const bool grid_2d = layout.components > 0 && layout.nodes_x > 2 && layout.nodes_z > 2;
+    const bool grid_2d = layout.nodes_x > 2 && layout.nodes_z > 2;
     method = free_count > kDirectSolveDofs && grid_2d ? StaticMethod::kMultigrid : StaticMethod::kDirect;
   }
   if (method == StaticMethod::kMultigrid) {
-    if (layout.components == 0) throw std::invalid_argument("static solve: multigrid needs a grid model");
     // Not make_unique: it would pass the matrix on by reference, and Eigen 3.4's sparse matrices,
     // having no move constructor, would be copied (360 MB at 10⁶ nodes).
     multigrid_.reset(new GridMultigrid(freeStiffness(model, position_in_free, free_count, false), free_dofs_, layout));

@@ -114,8 +114,7 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
     : nh_(std::move(nh)), options_(std::move(options)) {
   std::vector<std::string> problems;
   const auto overrides = parseOverrides(options_.overrides, problems);
-  scene_ = loadScene(options_.scene_path, &stability_limit_);
-  if (!overrides.empty()) scene_ = overrideScene(scene_, overrides, &stability_limit_);
+  scene_ = loadScene(options_.scene_path, overrides, &stability_limit_);
   for (const std::string& warning : sceneWarnings(scene_)) ROS_WARN_STREAM("scene: " << warning);
   wave_speeds_ = waveSpeedsOf(scene_);
   paused_ = options_.start_paused;

@@ -42,8 +42,7 @@ int run(int argc, char** argv) {
     }
   }
   double stability_limit = 0.0;
-  friction::Scene scene = friction::loadScene(scene_path, &stability_limit);
-  if (!overrides.empty()) scene = friction::overrideScene(scene, overrides, &stability_limit);
+  const friction::Scene scene = friction::loadScene(scene_path, overrides, &stability_limit);
   for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
   if (out_dir.empty()) out_dir = "results/" + scene.name;
   std::filesystem::create_directories(out_dir);
