@@ -5,7 +5,7 @@
 # Runs as root, or through sudo when not root.
 set -euo pipefail
 
-common=(build-essential cmake libeigen3-dev libsuitesparse-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev parallel
+common=(build-essential cmake libeigen3-dev libsuitesparse-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev parallel rsync
         python3-matplotlib python3-yaml xvfb xauth imagemagick libgl1-mesa-dri)
 if [ -d /opt/ros/noetic ]; then
   ros=(ros-noetic-catkin ros-noetic-roscpp ros-noetic-rosbag ros-noetic-rostest ros-noetic-roslaunch

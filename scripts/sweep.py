@@ -14,13 +14,15 @@ SWEEP.yaml names a base scene, fixed overrides and the parameters to vary:
       - {lattice.nodes_x: 57, lattice.nodes_z: 31}
       - {lattice.nodes_x: 113, lattice.nodes_z: 61}
 
-Each run is an independent friction_run process. GNU parallel spreads them over the local cores
-(--jobs, default all) and, with --hosts (parallel's --sshlogin list, e.g. "2/node1,2/node2,:"), over
-other machines that have this repository built at the same path, reached by ssh (parallel's
-PARALLEL_SSH environment variable names another ssh command). Its job log makes a rerun skip the
-runs that finished and retry the ones that failed; a failed run is reported and the others' results
-are kept. The runs' event tables are collected into DIR/events.csv with one column per varied
-parameter (DIR defaults to sweeps/<sweep file name>).
+Each run is an independent friction_run process, written down in its directory as command.sh.
+GNU parallel spreads the runs over the local cores (--jobs, default all) and, with --hosts
+(parallel's --sshlogin list, e.g. "2/node1,2/node2,:" where ":" is this machine), over other
+machines reached by ssh (parallel's PARALLEL_SSH environment variable names another ssh command).
+Those machines need this repository built at the same path and rsync; they need not share a file
+system: parallel copies each run's command.sh there and brings its directory back with rsync. Its
+job log makes a rerun skip the runs that finished and retry the ones that failed; a failed run is
+reported and the others' results are kept. The runs' event tables are collected into
+DIR/events.csv with one column per varied parameter (DIR defaults to sweeps/<sweep file name>).
 """
 import argparse
 import csv
@@ -61,6 +63,7 @@ def run_id(point):
 
 
 def command(spec, point, out_dir):
+    """The shell command of one run: friction_run with the sweep's overrides, its output logged."""
     args = [RUNNER, os.path.join(ROOT, spec["base"]), "--out", out_dir]
     for name, value in list((spec.get("set") or {}).items()) + list(point.items()):
         # Strings are YAML already (e.g. a stage program); numbers and booleans are written as YAML.
@@ -73,17 +76,24 @@ def run(path, jobs=None, hosts=None, out=None):
     spec = load(path)
     out = out or os.path.join(ROOT, "sweeps", os.path.splitext(os.path.basename(path))[0])
     points = list(combinations(spec))
-    commands = []
+    run_dirs = []
     for point in points:
         run_dir = os.path.join(out, "runs", run_id(point))
         os.makedirs(run_dir, exist_ok=True)
-        commands.append(command(spec, point, run_dir))
+        with open(os.path.join(run_dir, "command.sh"), "w") as handle:
+            handle.write("#!/bin/sh\nexec %s\n" % command(spec, point, run_dir))
+        run_dirs.append(run_dir)
     args = ["parallel", "--joblog", os.path.join(out, "joblog.txt"), "--resume-failed", "--halt", "never"]
     if jobs:
         args += ["--jobs", str(jobs)]
     if hosts:
-        args += ["--sshlogin", hosts, "--workdir", "."]
-    subprocess.run(args, input="\n".join(commands) + "\n", text=True)
+        # Absolute paths: rsync puts command.sh at the same path there and the run's directory back here.
+        args += ["--sshlogin", hosts, "--transferfile", "{}/command.sh", "--return", "{}"]
+    # parallel quotes the paths it hands rsync for the remote shell; rsync 3.2.4 and later would quote
+    # them again (a run named "normal_force=1000" comes back as "'./normal_force=1000'") unless told
+    # to pass them as they are.
+    environment = dict(os.environ, RSYNC_OLD_ARGS="1")
+    subprocess.run(args + ["sh {}/command.sh"], input="\n".join(run_dirs) + "\n", text=True, env=environment)
     return collect(spec, points, out)
 
 

@@ -2,10 +2,11 @@
 """The sweep tool (scripts/sweep.py) on the single-block scene, whose onset force is µ_s·F_Z exactly:
 every combination runs, a refused run is reported without losing the others, a rerun skips what is
 done, and runs spread over "remote" machines through GNU parallel's --sshlogin (with an ssh stand-in
-that runs the command here, so that no ssh server is needed)."""
+that runs the command here, so that no ssh server is needed), with and without a shared file system."""
 import csv
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -77,24 +78,57 @@ class SweepTest(unittest.TestCase):
         self.assertEqual(sum("normal_force=1000" in c for c in commands), 1)
         self.assertEqual(sum("normal_force=-5" in c for c in commands), 2)
 
-    def test_runs_spread_over_remote_hosts(self):
+    def write_ssh_stand_in(self, run_on_host):
+        """An ssh that runs the command here, through run_on_host (a shell line given $HOST and the
+        remote command in $@), and records the hosts it was asked for."""
         calls = os.path.join(self.work, "ssh_calls.txt")
         stand_in = os.path.join(self.work, "ssh")
         with open(stand_in, "w") as handle:
             # parallel calls `ssh HOST -- COMMAND...`, the command meant for the remote shell. sshd sets
             # SHELL, which parallel's remote side runs the job with (without it the job silently does
             # nothing and exits 0; CI runs the tests without SHELL).
-            handle.write('#!/bin/sh\necho "$1" >> %s\nshift\n[ "$1" = "--" ] && shift\n'
-                         'SHELL=/bin/sh; export SHELL\nexec /bin/sh -c "$*"\n' % calls)
+            handle.write('#!/bin/sh\nHOST=$1\necho "$HOST" >> %s\nshift\n[ "$1" = "--" ] && shift\n'
+                         'SHELL=/bin/sh; export SHELL\n%s\n' % (calls, run_on_host))
         # Through /bin/sh, so that a temporary directory mounted noexec does not matter.
-        with mock.patch.dict(os.environ, PARALLEL_SSH="/bin/sh " + stand_in):
+        return mock.patch.dict(os.environ, PARALLEL_SSH="/bin/sh " + stand_in), calls
+
+    def hosts_called(self, calls):
+        with open(calls) as handle:
+            return set(handle.read().split())
+
+    def test_runs_spread_over_remote_hosts(self):
+        environment, calls = self.write_ssh_stand_in('exec /bin/sh -c "$*"')
+        with environment:
             rows, failed = sweep.run(self.write_sweep("[1000, 2000, 3000, 4000]"), hosts="1/node1,1/node2",
                                      out=os.path.join(self.work, "out"))
         self.assertEqual(failed, [])
         self.assert_onsets_follow_amontons(rows, [1000.0, 2000.0, 3000.0, 4000.0])
-        with open(calls) as handle:
-            hosts = set(handle.read().split())
-        self.assertEqual(hosts, {"node1", "node2"})
+        self.assertEqual(self.hosts_called(calls), {"node1", "node2"})
+
+    def test_remote_hosts_need_not_share_the_file_system(self):
+        """Each stand-in host sees its own disk mounted over the sweep's output directory, so a run's
+        results reach this machine only if the sweep brings them back."""
+        out, disks = os.path.join(self.work, "out"), os.path.join(self.work, "disks")
+        os.makedirs(os.path.join(disks, "probe"))
+        os.makedirs(out)
+        probe = subprocess.run(["unshare", "--mount", "mount", "--bind", os.path.join(disks, "probe"), out],
+                               capture_output=True)
+        if probe.returncode != 0:
+            self.skipTest("no mount namespace here to give each host its own disk: %s" % probe.stderr.strip())
+        environment, calls = self.write_ssh_stand_in(
+            'mkdir -p %s/$HOST\nexec unshare --mount /bin/sh -c \'mount --bind "$0" "$1" && exec /bin/sh -c "$2"\' '
+            '%s/$HOST %s "$*"' % (disks, disks, out))
+        with environment:
+            rows, failed = sweep.run(self.write_sweep("[1000, 2000, 3000, 4000]"), hosts="1/node1,1/node2",
+                                     out=out)
+        self.assertEqual(failed, [])
+        self.assert_onsets_follow_amontons(rows, [1000.0, 2000.0, 3000.0, 4000.0])
+        ran_on = {host: set(name for name in os.listdir(os.path.join(disks, host, "runs"))
+                            if os.path.exists(os.path.join(disks, host, "runs", name, "summary.txt")))
+                  for host in ("node1", "node2")}
+        self.assertTrue(ran_on["node1"] and ran_on["node2"], ran_on)
+        self.assertEqual(ran_on["node1"] | ran_on["node2"], set(os.listdir(os.path.join(out, "runs"))))
+        self.assertFalse(ran_on["node1"] & ran_on["node2"])
 
 
 if __name__ == "__main__":
