@@ -29,10 +29,16 @@ class ContactInterface {
   /// Sticks every node where it is, with no stored interfacial shear and slip measured from here.
   void reset(const Vector& u);
 
-  /// `force` holds every force but friction on the degrees of freedom (N). Records its interface
-  /// entries and the normal forces for the state updates, and rewrites those entries as accelerations
-  /// (m/s²): (force + friction)·`inverse_mass`. The other entries are left to the caller.
-  void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force);
+  /// `force` holds every force but friction on the degrees of freedom (N). Records the interface
+  /// entries of nodes [first_node, end_node) and their normal forces for the state updates, and rewrites
+  /// those entries as accelerations (m/s²): (force + friction)·`inverse_mass`. The other entries are
+  /// left to the caller. Nodes are independent here, so a caller may go range by range.
+  void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
+                     int first_node, int end_node);
+  /// The same for every interface node.
+  void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force) {
+    applyFriction(raw, u, inverse_mass, force, 0, size());
+  }
   /// After a change of state: recomputes the friction from the recorded forces and rewrites the
   /// interface entries of `acceleration` (m/s²) as (other force + friction)·`inverse_mass`.
   void reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration);
@@ -90,10 +96,11 @@ class ContactInterface {
   void refreshCoefficients(int node);
   /// Forgets a node's load history (it has just stuck).
   void clearLoad(int node);
-  /// Records the interface entries of `force_to_acceleration` (N, every force but friction) as the
-  /// other forces, computes friction_ from them, and overwrites those entries with accelerations (m/s²),
+  /// Records the interface entries of nodes [first_node, end_node) of `force_to_acceleration` (N, every
+  /// force but friction) as the other forces, computes friction_ from them, and overwrites those entries with accelerations (m/s²),
   /// (other force + friction)·`inverse_mass`.
-  void accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration);
+  void accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration,
+                              int first_node, int end_node);
 
   std::unique_ptr<FrictionLaw> law_;
   std::vector<int> dofs_;

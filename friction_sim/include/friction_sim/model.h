@@ -46,8 +46,8 @@ class StripHooks {
   /// Called before the evaluation reads the state of these degrees of freedom or writes their forces:
   /// the caller may still change them here (the integrator's drift).
   virtual void prepare(int /*first*/, int /*end*/) {}
-  /// Called once the forces on these degrees of freedom are final and their velocities will not be
-  /// read again (the integrator's closing kick).
+  /// Called once the forces on these degrees of freedom are final, and so are the normal forces of the
+  /// interface nodes among them, and their velocities will not be read again (the closing kick).
   virtual void finish(int /*first*/, int /*end*/) {}
 };
 

@@ -120,20 +120,24 @@ void frictionPass(int n, double k_t, double inverse_mass, const double* __restri
 }
 }  // namespace
 
-void ContactInterface::accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration) {
-  frictionPass(size(), k_t_, inverse_mass, u + first_dof_, anchor_.data(), normal_.data(),
-               sliding_coefficient_.data(), stuck_weight_.data(), sliding_sign_.data(), other_force_.data(),
-               friction_.data(), force_to_acceleration + first_dof_);
+void ContactInterface::accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration,
+                                              int first_node, int end_node) {
+  const int offset = first_dof_ + first_node;
+  frictionPass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
+               normal_.data() + first_node, sliding_coefficient_.data() + first_node,
+               stuck_weight_.data() + first_node, sliding_sign_.data() + first_node,
+               other_force_.data() + first_node, friction_.data() + first_node, force_to_acceleration + offset);
 }
 
-void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force) {
-  std::copy_n(raw.normal_force.data(), size(), normal_.data());
-  accelerateWithFriction(u.data(), inverse_mass, force.data());
+void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
+                                     int first_node, int end_node) {
+  std::copy(raw.normal_force.data() + first_node, raw.normal_force.data() + end_node, normal_.data() + first_node);
+  accelerateWithFriction(u.data(), inverse_mass, force.data(), first_node, end_node);
 }
 
 void ContactInterface::reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration) {
   std::copy_n(other_force_.data(), size(), acceleration.data() + first_dof_);
-  accelerateWithFriction(u.data(), inverse_mass, acceleration.data());
+  accelerateWithFriction(u.data(), inverse_mass, acceleration.data(), 0, size());
 }
 
 void ContactInterface::beginStep(const Vector& u, const Vector& v) {

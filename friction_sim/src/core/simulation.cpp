@@ -181,29 +181,35 @@ namespace {
 /// L2 cache between the force evaluation and the integrator's passes.
 constexpr int kStripNodes = 4096;
 
-/// Turns each finished strip's forces into accelerations before passing it on; the interface's
-/// entries wait for friction.
+/// Turns each finished strip's forces into accelerations before passing it on: the interface's entries
+/// with their friction, which needs nothing beyond the strip's own nodes.
 class AccelerationStrips : public StripHooks {
  public:
-  AccelerationStrips(StripHooks& caller, Vector& a, double inverse_mass, int interface_begin, int interface_end)
-      : caller_(caller), a_(a), inverse_mass_(inverse_mass), interface_begin_(interface_begin),
-        interface_end_(interface_end) {}
+  AccelerationStrips(StripHooks& caller, Vector& a, double inverse_mass, ContactInterface& contact,
+                     const ForceEvaluation& evaluation, const Vector& u)
+      : caller_(caller), a_(a), inverse_mass_(inverse_mass), contact_(contact), evaluation_(evaluation), u_(u),
+        interface_begin_(contact.firstDof()), interface_end_(interface_begin_ + contact.size()) {}
   void prepare(int first, int end) override { caller_.prepare(first, end); }
   void finish(int first, int end) override {
-    finishOutsideInterface(first, std::min(end, interface_begin_));
-    finishOutsideInterface(std::max(first, interface_end_), end);
+    scaleOutsideInterface(first, std::min(end, interface_begin_));
+    const int first_node = std::max(first, interface_begin_) - interface_begin_;
+    const int end_node = std::min(end, interface_end_) - interface_begin_;
+    if (first_node < end_node) contact_.applyFriction(evaluation_, u_, inverse_mass_, a_, first_node, end_node);
+    scaleOutsideInterface(std::max(first, interface_end_), end);
+    caller_.finish(first, end);
   }
 
  private:
-  void finishOutsideInterface(int first, int end) {
-    if (first >= end) return;
-    a_.segment(first, end - first) *= inverse_mass_;
-    caller_.finish(first, end);
+  void scaleOutsideInterface(int first, int end) {
+    if (first < end) a_.segment(first, end - first) *= inverse_mass_;
   }
 
   StripHooks& caller_;
   Vector& a_;
   double inverse_mass_;
+  ContactInterface& contact_;
+  const ForceEvaluation& evaluation_;
+  const Vector& u_;
   int interface_begin_, interface_end_;
 };
 }  // namespace
@@ -214,11 +220,8 @@ double Simulation::acceleration(const Vector& u, const Vector& v, double t, Vect
 }
 
 double Simulation::accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) {
-  const int interface_begin = contact_.firstDof(), interface_end = interface_begin + contact_.size();
-  AccelerationStrips strips(hooks, a, inverse_mass_, interface_begin, interface_end);
+  AccelerationStrips strips(hooks, a, inverse_mass_, contact_, evaluation_, u);
   model_->evaluateInStrips(u, v, stage_.positionAfter(t - time_), a, evaluation_, strips, kStripNodes);
-  contact_.applyFriction(evaluation_, u, inverse_mass_, a);
-  hooks.finish(interface_begin, interface_end);
   return evaluation_.viscous_power;
 }
 
