@@ -121,6 +121,37 @@ TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
   EXPECT_DOUBLE_EQ(u_[0], 0.5 * acceleration * 0.25 * dt * dt);
 }
 
+// A node that has just stuck starts from a cleared load: if it crosses µ_s·N in the next update, the
+// crossing is interpolated from zero load, at (1 − 0)/(1.25 − 0) = 0.8 of the step for a load ratio of
+// 1.25, whether it stuck again in the step's finishStep or in the state update before.
+TEST_F(OneNode, ReStuckNodeCrossingInTheSameStepCountsFromAClearedLoad) {
+  update(4.1, 10.0);
+  net(4.1, 10.0);
+  const double dt = 1e-3;
+  contact_.beginStep(u_, v_);
+  contact_.finishStep(u_, v_, dt);  // clears "just unstuck"
+  contact_.updateStates(u_, v_, dt, 1.0);  // sliding: its load ratio here is µ_k/µ_s, not zero
+  v_[0] = 2.0;
+  contact_.beginStep(u_, v_);
+  v_[0] = -1.0;
+  ASSERT_TRUE(contact_.finishStep(u_, v_, dt));
+  ASSERT_EQ(contact_.state(0), ContactState::Stuck);
+  net(5.0, 10.0);
+  ASSERT_TRUE(contact_.updateStates(u_, v_, dt, 1.0));
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), 0.8);
+}
+
+TEST_F(OneNode, NodeStuckOnRegainingContactCrossingInTheNextStepCountsFromAClearedLoad) {
+  update(1.0, 0.0);
+  ASSERT_TRUE(update(1.0, 10.0));  // returns at rest: sticks
+  ASSERT_EQ(contact_.state(0), ContactState::Stuck);
+  net(5.0, 10.0);
+  ASSERT_TRUE(contact_.updateStates(u_, v_, 1e-3, 1.0));
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), 0.8);
+}
+
 TEST(LinearSlipWeakening, WeakensLinearlyOverTheWeakeningLength) {
   LinearSlipWeakening law(kMuS, kMuK, 1e-5);
   law.resize(2);

@@ -68,7 +68,20 @@ class RecordingHooks : public StripHooks {
  public:
   RecordingHooks(Vector& u, const Vector& shift, const Vector& force)
       : u_(u), shift_(shift), force_(force), prepared_(u.size(), 0), finished_(u.size(), 0),
-        forces_at_finish_(Vector::Constant(u.size(), std::nan(""))) {}
+        forces_at_finish_(Vector::Constant(u.size(), std::nan(""))),
+        normal_forces_at_finish_(Vector::Constant(u.size(), std::nan(""))) {}
+  /// Also kicks `v` by `kick` when a dof is finished, as the closing kick does: a force that read a
+  /// finished dof's velocity would change.
+  void kickAtFinish(Vector& v, const Vector& kick) {
+    v_ = &v;
+    kick_ = &kick;
+  }
+  /// Also records, at finish, the normal force of each interface node (`normal_force`, per node) whose
+  /// dof (from `first_interface_dof` on, contiguous) is finished.
+  void recordNormalForces(const Vector& normal_force, int first_interface_dof) {
+    normal_force_ = &normal_force;
+    first_interface_dof_ = first_interface_dof;
+  }
   void prepare(int first, int end) override {
     for (int i = first; i < end; ++i) {
       ++prepared_[i];
@@ -80,6 +93,9 @@ class RecordingHooks : public StripHooks {
     for (int i = first; i < end; ++i) {
       ++finished_[i];
       forces_at_finish_[i] = force_[i];
+      if (v_) (*v_)[i] += (*kick_)[i];
+      const int node = i - first_interface_dof_;
+      if (normal_force_ && node >= 0 && node < normal_force_->size()) normal_forces_at_finish_[i] = (*normal_force_)[node];
     }
   }
   bool eachOnce() const {
@@ -88,13 +104,19 @@ class RecordingHooks : public StripHooks {
   }
   bool untouchedForceAtPrepare() const { return untouched_force_at_prepare_; }
   const Vector& forcesAtFinish() const { return forces_at_finish_; }
+  /// Per dof; NaN where the dof is not an interface node's.
+  const Vector& normalForcesAtFinish() const { return normal_forces_at_finish_; }
 
  private:
   Vector& u_;
   const Vector& shift_;
   const Vector& force_;
+  Vector* v_ = nullptr;
+  const Vector* kick_ = nullptr;
+  const Vector* normal_force_ = nullptr;
+  int first_interface_dof_ = 0;
   std::vector<int> prepared_, finished_;
-  Vector forces_at_finish_;
+  Vector forces_at_finish_, normal_forces_at_finish_;
   bool untouched_force_at_prepare_ = true;
 };
 

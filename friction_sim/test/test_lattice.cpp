@@ -205,54 +205,5 @@ TEST(LatticeSpringForm, LinearisedForcesAgreeWithGeometricAtSmallStrain) {
   EXPECT_NEAR(a.viscous_power, b.viscous_power, 1e-12 * a.viscous_power);
 }
 
-/// The loaded slider at 21 × 11 nodes, with the top load and pusher of `variant`.
-Scene stripScene(int variant) {
-  Scene scene = testing::pmmaScene(21, 11);
-  if (variant == 1) {
-    // A spring mattress that holds the top row in x as well, and a pusher band up to the top row.
-    scene.load.top = TopLoadKind::SpringMattress;
-    scene.load.mattress_horizontal_stiffness = 1e7;
-    scene.pusher.band_min = 0.02;
-    scene.pusher.band_max = scene.geometry.height;
-  }
-  return scene;
-}
-
-TEST(LatticeStrips, StripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
-  for (int variant : {0, 1}) {
-    SCOPED_TRACE(variant);
-    const Lattice2D lattice(stripScene(variant));
-    const int n = lattice.dofCount();
-    Vector u(n), v(n), shift(n);
-    for (int i = 0; i < n; ++i) {
-      u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0) - (i >= n / 2 ? 1e-6 : 0.0);  // pressed into the track
-      v[i] = 1e-3 * std::cos(0.21 * i);
-      shift[i] = 1e-7 * std::cos(0.13 * i * i);
-    }
-    // The whole state shifted first, then one sweep with no hooks.
-    ForceEvaluation whole;
-    lattice.evaluate(u + shift, v, 1e-5, whole);
-    ASSERT_GT(whole.shear_force, 0.0);
-    for (int strip_nodes : {1, 2 * 21, 3 * 21}) {
-      SCOPED_TRACE(strip_nodes);
-      Vector u_strips = u;
-      ForceEvaluation strips;
-      strips.force = Vector::Constant(n, std::nan(""));
-      testing::RecordingHooks hooks(u_strips, shift, strips.force);
-      lattice.evaluateInStrips(u_strips, v, 1e-5, strips.force, strips, hooks, strip_nodes);
-      EXPECT_TRUE(hooks.eachOnce());
-      EXPECT_TRUE(hooks.untouchedForceAtPrepare());
-      // Bit for bit: the same arithmetic in the same order, only interleaved with the hooks; a row read
-      // before it was prepared (shifted) would change the forces.
-      EXPECT_TRUE((strips.force.array() == whole.force.array()).all());
-      EXPECT_TRUE((hooks.forcesAtFinish().array() == whole.force.array()).all());
-      EXPECT_TRUE((strips.normal_force.array() == whole.normal_force.array()).all());
-      EXPECT_EQ(strips.shear_force, whole.shear_force);
-      EXPECT_EQ(strips.normal_load, whole.normal_load);
-      EXPECT_EQ(strips.viscous_power, whole.viscous_power);
-    }
-  }
-}
-
 }  // namespace
 }  // namespace friction

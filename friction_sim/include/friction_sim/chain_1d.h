@@ -30,6 +30,11 @@ class Chain1D : public Model {
 
   void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                     ForceEvaluation& out) const override;
+  /// Strips of `strip_nodes` blocks when driven at the side: F_X, and with it every normal force, is
+  /// known once block 0 is prepared. Top driving sums every block's driving force into F_X first, so it
+  /// is evaluated in one strip.
+  void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                        ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const override;
   double elasticEnergy(const Vector& u, double stage_position) const override;
   double externalWork(const Vector&, const Vector&) const override { return 0.0; }
   SparseMatrix stiffnessMatrix() const override;
@@ -61,7 +66,12 @@ class Chain1D : public Model {
     }
   }
   /// N per block, w_i before clamping at zero, as an Eigen expression (no allocation in the step).
-  auto normalForceExpression(double shear_force) const;
+  void evaluateTopDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                         ForceEvaluation& out) const;
+  void evaluateSideDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                          ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const;
+  /// w_i of blocks [first, first + count) at the given F_X (N), before clamping at 0.
+  auto normalForceExpression(double shear_force, int first, int count) const;
   /// N, c = 2·g·h·F_X/(L·Σξ²), the friction-induced torque's share of each block's normal force per ξ.
   double torqueCoefficient(double shear_force) const;
 

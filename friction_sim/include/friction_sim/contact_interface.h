@@ -96,6 +96,8 @@ class ContactInterface {
   void refreshCoefficients(int node);
   /// Forgets a node's load history (it has just stuck).
   void clearLoad(int node);
+  /// At the end of a state update: its loads become the next update's previous ones.
+  void rotateLoads();
   /// Records the interface entries of nodes [first_node, end_node) of `force_to_acceleration` (N, every
   /// force but friction) as the other forces, computes friction_ from them, and overwrites those entries with accelerations (m/s²),
   /// (other force + friction)·`inverse_mass`.
@@ -119,9 +121,11 @@ class ContactInterface {
   std::vector<char> just_unstuck_;
   std::vector<int> unstuck_last_step_, restuck_last_step_;
   std::vector<double> transition_fraction_;
-  // A stuck node's load at the last update and the one before (for the crossing's interpolation): the
-  // force needed to hold it (N) and its threshold µ_s·N (N); 0 and 1 for a node that has just stuck.
+  // A stuck node's load at the last friction pass and at the last state update (for the crossing's
+  // interpolation): the force needed to hold it (N) and its threshold µ_s·N (N); 0 and 1 for a node
+  // that has just stuck.
   std::vector<double> held_force_, threshold_, previous_held_force_, previous_threshold_;
+  std::int64_t attention_ = 0;  ///< nodes that needed a state rule at the last friction pass
   // Start-of-step copies for re-stick interpolation and dissipation.
   std::vector<double> start_u_, start_v_, start_friction_;
   double dissipation_ = 0.0;

@@ -1,5 +1,6 @@
 #include "friction_sim/chain_1d.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace friction {
@@ -44,17 +45,36 @@ double Chain1D::torqueCoefficient(double shear_force) const {
   return xi_square_sum_ > 0.0 ? 2.0 * torque_share_ * pushing_height_ * shear_force / (length_ * xi_square_sum_) : 0.0;
 }
 
-auto Chain1D::normalForceExpression(double shear_force) const {
-  return normal_force_ / n_ * tilt_factor_ + torqueCoefficient(shear_force) * xi_;
+auto Chain1D::normalForceExpression(double shear_force, int first, int count) const {
+  return normal_force_ / n_ * tilt_factor_.segment(first, count) + torqueCoefficient(shear_force) * xi_.segment(first, count);
 }
 
 std::vector<double> Chain1D::normalForces(double shear_force) const {
-  const Eigen::ArrayXd w = normalForceExpression(shear_force);
+  const Eigen::ArrayXd w = normalForceExpression(shear_force, 0, n_);
   return {w.begin(), w.end()};
 }
 
 void Chain1D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                            ForceEvaluation& out) const {
+  if (top_driving_) {
+    evaluateTopDriven(u, v, stage_position, force, out);
+  } else {
+    StripHooks none;
+    evaluateSideDriven(u, v, stage_position, force, out, none, n_);
+  }
+}
+
+void Chain1D::evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                               ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const {
+  if (top_driving_) {
+    Model::evaluateInStrips(u, v, stage_position, force, out, hooks, strip_nodes);
+  } else {
+    evaluateSideDriven(u, v, stage_position, force, out, hooks, strip_nodes);
+  }
+}
+
+void Chain1D::evaluateTopDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                                ForceEvaluation& out) const {
   force.resize(n_);
   const double* __restrict x = u.data();
   const double* __restrict w = v.data();
@@ -70,18 +90,56 @@ void Chain1D::evaluateInto(const Vector& u, const Vector& v, double stage_positi
     f[n_ - 1] = -tension(n_ - 2);
   }
   const auto driving = driving_stiffness_ * (stage_position + pusher_offset_.array() - u.array());
-  double shear = 0.0;
-  if (top_driving_) {
-    force.array() += driving;
-    shear = driving.sum();
-  } else {
-    shear = driving_stiffness_[0] * (stage_position + pusher_offset_[0] - u[0]);
-    force[0] += shear;
-  }
+  force.array() += driving;
+  const double shear = driving.sum();
   out.shear_force = shear;
   out.normal_load = normal_force_;
   out.viscous_power = eta_ * (v.tail(n_ - 1).array() - v.head(n_ - 1).array()).square().sum();
-  out.normal_force = normalForceExpression(shear).max(0.0);
+  out.normal_force = normalForceExpression(shear, 0, n_).max(0.0);
+}
+
+void Chain1D::evaluateSideDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                                 ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const {
+  force.resize(n_);
+  out.normal_force.resize(n_);
+  const double* __restrict x = u.data();
+  const double* __restrict w = v.data();
+  double* __restrict f = force.data();
+  // As in evaluateTopDriven, each tension is computed for both of its blocks.
+  auto tension = [&](int i) { return k_ * (x[i + 1] - x[i]) + eta_ * (w[i + 1] - w[i]); };
+  int prepared = 0;
+  auto prepareThrough = [&](int end) {
+    if (prepared >= end) return;
+    const int next = std::min(n_, std::max(end, prepared + strip_nodes));
+    hooks.prepare(prepared, next);
+    prepared = next;
+  };
+  prepareThrough(1);
+  const double shear = driving_stiffness_[0] * (stage_position + pusher_offset_[0] - u[0]);
+  double squared_velocity_differences = 0.0;
+  // The tension of the bond to the left of the strip, taken before that block was finished (its
+  // velocity is then the step's end velocity, no longer the one the force must use).
+  double left_tension = 0.0;
+  for (int first = 0; first < n_; first += strip_nodes) {
+    const int end = std::min(n_, first + strip_nodes);
+    prepareThrough(std::min(n_, end + 1));  // the last block's bond reads the next strip's first block
+    const int bonds_end = std::min(end, n_ - 1);  // the bonds whose left block is in the strip
+    f[first] = (first < n_ - 1 ? tension(first) : 0.0) - left_tension;
+    for (int i = first + 1; i < bonds_end; ++i) f[i] = tension(i) - tension(i - 1);
+    if (end == n_ && first < n_ - 1) f[n_ - 1] = -tension(n_ - 2);
+    if (first == 0) f[0] += shear;
+    const int count = end - first;
+    out.normal_force.segment(first, count) = normalForceExpression(shear, first, count).max(0.0);
+    if (bonds_end > first) {
+      squared_velocity_differences +=
+          (v.segment(first + 1, bonds_end - first).array() - v.segment(first, bonds_end - first).array()).square().sum();
+    }
+    if (end < n_) left_tension = tension(end - 1);
+    hooks.finish(first, end);
+  }
+  out.shear_force = shear;
+  out.normal_load = normal_force_;
+  out.viscous_power = eta_ * squared_velocity_differences;
 }
 
 double Chain1D::elasticEnergy(const Vector& u, double stage_position) const {

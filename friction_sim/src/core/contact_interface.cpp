@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 namespace friction {
@@ -79,54 +80,52 @@ inline double frictionOf(double stuck_weight, double holding, double sliding_coe
                          double sliding_sign) {
   return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
 }
-/// The state update's pass over every node, branch-free so that it vectorises (restrict holds for
-/// parameters): the load each stuck node carries, its friction from the last frictionPass (the anchor
-/// spring's force, or with k_T = 0 the rigid reaction), and its threshold µ_s·N. The other nodes'
-/// loads are never read: a node that sticks again starts with a cleared load. Returns how many nodes need one of the state rules: a stuck node
-/// in contact over its threshold, a node losing contact or a detached node regaining it.
-int loadPass(int n, const double* __restrict friction, const double* __restrict normal,
-             const double* __restrict mu, const double* __restrict stuck, const double* __restrict sign,
-             double* __restrict held, double* __restrict threshold) {
-  int attention = 0;
-  for (int node = 0; node < n; ++node) {
-    // A stuck node's friction is the force that holds it.
-    held[node] = std::abs(friction[node]);
-    threshold[node] = mu[node] * normal[node];
-    // 0/1 flags as doubles, so that every lane of the loop has the same width.
-    const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
-    const double detached = 1.0 - stuck[node] - std::abs(sign[node]);
-    const double holding = stuck[node] * in_contact;
-    attention += (holding > 0.0 && held[node] > threshold[node]) || (in_contact != 1.0 - detached);
-  }
-  return attention;
-}
-
 /// Turns every node's other force into its acceleration: records the force in `other`, the friction
 /// in `friction`, and overwrites `force_to_acceleration` with (other force + friction)·inverse_mass.
+/// Also records each node's load for the state update while the values are at hand: the force that
+/// holds it (a stuck node's friction: the anchor spring's force, or with k_T = 0 the rigid reaction)
+/// and its threshold µ_s·N. Returns how many nodes need one of the state rules: a stuck node in
+/// contact over its threshold, a node losing contact or a detached node regaining it.
 /// Branch-free and in one pass. A function of its own because GCC honours restrict only on parameters;
 /// without it the loop needs more run-time alias checks than GCC allows and is left scalar.
-void frictionPass(int n, double k_t, double inverse_mass, const double* __restrict x,
-                  const double* __restrict anchor, const double* __restrict normal, const double* __restrict mu,
-                  const double* __restrict stuck, const double* __restrict sign, double* __restrict other,
-                  double* __restrict friction, double* __restrict force_to_acceleration) {
+std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* __restrict x,
+                          const double* __restrict anchor, const double* __restrict normal,
+                          const double* __restrict static_mu, const double* __restrict mu,
+                          const double* __restrict stuck, const double* __restrict sign, double* __restrict other,
+                          double* __restrict friction, double* __restrict held, double* __restrict threshold,
+                          double* __restrict force_to_acceleration) {
   const double rigid_weight = k_t > 0.0 ? 0.0 : 1.0;
+  // Counted in 64 bits, the width of every other lane of the loop: a mix of widths costs conversions.
+  std::int64_t attention = 0;
   for (int node = 0; node < n; ++node) {
     const double force = force_to_acceleration[node];
     other[node] = force;
     const double holding = holdingForce(k_t, rigid_weight, anchor[node], x[node], force);
     friction[node] = frictionOf(stuck[node], holding, mu[node], normal[node], sign[node]);
     force_to_acceleration[node] = (force + friction[node]) * inverse_mass;
+    held[node] = std::abs(friction[node]);
+    threshold[node] = static_mu[node] * normal[node];
+    // 0/1 flags as doubles. The weights are 0 or 1: stuck + |sign| is 1 unless the node is detached.
+    const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
+    const double attached = stuck[node] + std::abs(sign[node]);
+    const double holding_in_contact = stuck[node] * in_contact;
+    attention += (holding_in_contact > 0.0 && held[node] > threshold[node]) || in_contact != attached;
   }
+  return attention;
 }
 }  // namespace
 
 void ContactInterface::accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration,
                                               int first_node, int end_node) {
   const int offset = first_dof_ + first_node;
-  frictionPass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
-               normal_.data() + first_node, sliding_coefficient_.data() + first_node,
-               stuck_weight_.data() + first_node, sliding_sign_.data() + first_node,
-               other_force_.data() + first_node, friction_.data() + first_node, force_to_acceleration + offset);
+  // The ranges of one evaluation come in order from node 0.
+  if (first_node == 0) attention_ = 0;
+  attention_ += frictionPass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
+                             normal_.data() + first_node, static_coefficient_.data() + first_node,
+                             sliding_coefficient_.data() + first_node, stuck_weight_.data() + first_node,
+                             sliding_sign_.data() + first_node, other_force_.data() + first_node,
+                             friction_.data() + first_node, held_force_.data() + first_node,
+                             threshold_.data() + first_node, force_to_acceleration + offset);
 }
 
 void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
@@ -197,8 +196,10 @@ void ContactInterface::stick(int node, const Vector& u) {
 }
 
 void ContactInterface::clearLoad(int node) {
-  held_force_[node] = 0.0;
-  threshold_[node] = 1.0;
+  // Both buffers: a node that sticks again before the state update (finishStep) has its load at the
+  // update's previous slot; one that sticks during it, at the slot that becomes the previous one.
+  held_force_[node] = previous_held_force_[node] = 0.0;
+  threshold_[node] = previous_threshold_[node] = 1.0;
 }
 
 void ContactInterface::startSliding(int node, int direction) {
@@ -210,16 +211,20 @@ void ContactInterface::startSliding(int node, int direction) {
   unstuck_last_step_.push_back(node);
 }
 
+void ContactInterface::rotateLoads() {
+  held_force_.swap(previous_held_force_);
+  threshold_.swap(previous_threshold_);
+}
+
 bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node_mass) {
   unstuck_last_step_.clear();
   const int n = size();
-  // First, branch-free over every node: the load of the stuck nodes in contact, and whether any node
-  // needs one of the rules below. Usually none does, and the step ends here.
-  held_force_.swap(previous_held_force_);
-  threshold_.swap(previous_threshold_);
-  const int attention = loadPass(n, friction_.data(), normal_.data(), static_coefficient_.data(), stuck_weight_.data(),
-                                 sliding_sign_.data(), held_force_.data(), threshold_.data());
-  if (attention == 0) return false;
+  // The last friction pass recorded every node's load and whether any node needs one of the rules
+  // below. Usually none does, and the step ends here.
+  if (attention_ == 0) {
+    rotateLoads();
+    return false;
+  }
   bool changed = false;
   for (int node = 0; node < n; ++node) {
     const int dof = dofs_[node];
@@ -259,6 +264,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     dissipation_ -= sliding_friction * catch_up;
     changed = true;
   }
+  rotateLoads();
   return changed;
 }
 

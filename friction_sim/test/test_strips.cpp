@@ -1,0 +1,99 @@
+// Force evaluation in strips (the fused integrator step's sweep): each model's strips give the forces of
+// one sweep and keep the hook contract of model.h.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "friction_sim/chain_1d.h"
+#include "friction_sim/lattice_2d.h"
+#include "test_helpers.h"
+
+namespace friction {
+namespace {
+
+/// Evaluates `model` in strips of each size, with hooks that drift the state when a dof is prepared
+/// and kick its velocity when it is finished, against one sweep over the drifted state. The forces and
+/// normal forces must be the same bit for bit: a dof read before it was prepared, or a velocity read
+/// after its dof was finished, would change them. The damping power is a sum taken strip by strip, so
+/// it may differ from the one sweep's in the last digits (`power_tolerance`, relative).
+void expectStripsGiveOneSweep(const Model& model, const Vector& u, double stage_position,
+                              const std::vector<int>& strip_sizes, double power_tolerance) {
+  const int n = model.dofCount();
+  Vector v(n), shift(n), kick(n);
+  for (int i = 0; i < n; ++i) {
+    v[i] = 1e-3 * std::cos(0.21 * i);
+    shift[i] = 1e-7 * std::cos(0.13 * i * i);
+    kick[i] = 1e-4 * std::sin(0.7 * i + 0.3);
+  }
+  ForceEvaluation whole;
+  model.evaluate(u + shift, v, stage_position, whole);
+  ASSERT_GT(whole.shear_force, 0.0);
+  const int first_interface_dof = model.interfaceDof(0);
+  for (int strip_nodes : strip_sizes) {
+    SCOPED_TRACE(strip_nodes);
+    Vector u_strips = u, v_strips = v;
+    ForceEvaluation strips;
+    strips.force = Vector::Constant(n, std::nan(""));
+    testing::RecordingHooks hooks(u_strips, shift, strips.force);
+    hooks.kickAtFinish(v_strips, kick);
+    hooks.recordNormalForces(strips.normal_force, first_interface_dof);
+    model.evaluateInStrips(u_strips, v_strips, stage_position, strips.force, strips, hooks, strip_nodes);
+    EXPECT_TRUE(hooks.eachOnce());
+    EXPECT_TRUE(hooks.untouchedForceAtPrepare());
+    EXPECT_TRUE((strips.force.array() == whole.force.array()).all());
+    EXPECT_TRUE((hooks.forcesAtFinish().array() == whole.force.array()).all());
+    EXPECT_TRUE((strips.normal_force.array() == whole.normal_force.array()).all());
+    // A finished strip's interface normal forces are final (the simulation applies friction then).
+    for (int node = 0; node < model.interfaceNodeCount(); ++node) {
+      EXPECT_EQ(hooks.normalForcesAtFinish()[model.interfaceDof(node)], whole.normal_force[node]) << node;
+    }
+    EXPECT_EQ(strips.shear_force, whole.shear_force);
+    EXPECT_EQ(strips.normal_load, whole.normal_load);
+    EXPECT_NEAR(strips.viscous_power, whole.viscous_power, power_tolerance * whole.viscous_power);
+  }
+}
+
+/// The loaded slider at 21 × 11 nodes, with the top load and pusher of `variant`.
+Scene latticeStripScene(int variant) {
+  Scene scene = testing::pmmaScene(21, 11);
+  if (variant == 1) {
+    // A spring mattress that holds the top row in x as well, and a pusher band up to the top row.
+    scene.load.top = TopLoadKind::SpringMattress;
+    scene.load.mattress_horizontal_stiffness = 1e7;
+    scene.pusher.band_min = 0.02;
+    scene.pusher.band_max = scene.geometry.height;
+  }
+  return scene;
+}
+
+TEST(LatticeStrips, StripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
+  for (int variant : {0, 1}) {
+    SCOPED_TRACE(variant);
+    const Lattice2D lattice(latticeStripScene(variant));
+    const int n = lattice.dofCount();
+    Vector u(n);
+    for (int i = 0; i < n; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0) - (i >= n / 2 ? 1e-6 : 0.0);  // pressed in
+    // Strips of whole rows: one, two and three rows of 21 nodes. The power is summed column by column
+    // over the whole sweep, so it is the same bit for bit.
+    expectStripsGiveOneSweep(lattice, u, 1e-5, {1, 2 * 21, 3 * 21}, 0.0);
+  }
+}
+
+TEST(ChainStrips, SideDrivenStripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
+  // 23 blocks, with tilt and the torque term, so that every normal force depends on F_X.
+  Scene scene;
+  scene.model = ModelKind::Chain1D;
+  scene.chain.blocks = 23;
+  scene.chain.tilt = 0.3;
+  scene.chain.torque_share = 1.0;
+  scene.pusher.height = 0.005;
+  const Chain1D chain(scene);
+  Vector u(23);
+  for (int i = 0; i < 23; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0);
+  // Strips of single blocks, of 4 and 5 (a shorter last strip) and one strip.
+  expectStripsGiveOneSweep(chain, u, 1e-5, {1, 4, 5, 23}, 1e-12);
+}
+
+}  // namespace
+}  // namespace friction
