@@ -38,6 +38,14 @@ class OneNode : public ::testing::Test {
     net(other, normal);
     return contact_.updateStates(u_, v_, 0.0, 1.0);
   }
+  /// Unsticks the node forwards and ends one step of length `dt` with it sliding, so that it is no longer
+  /// "just unstuck" and may re-stick in the next step.
+  void slideThroughOneStep(double dt) {
+    update(4.1, 10.0);
+    net(4.1, 10.0);
+    contact_.beginStep(u_, v_);
+    contact_.finishStep(u_, v_, dt);
+  }
 
   Chain1D block_;
   ContactInterface contact_;
@@ -68,12 +76,9 @@ TEST_F(OneNode, SlidesBackwardsWithFrictionReversed) {
 }
 
 TEST_F(OneNode, ReSticksAtTheInterpolatedZeroCrossingOfTheVelocity) {
-  update(4.1, 10.0);
-  net(4.1, 10.0);
   // A step that is not the one right after unsticking: the velocity goes from +2 to −1 m/s.
   const double dt = 1e-3;
-  contact_.beginStep(u_, v_);
-  contact_.finishStep(u_, v_, dt);  // clears "just unstuck"
+  slideThroughOneStep(dt);
   v_[0] = 2.0;
   u_[0] = 0.5;
   contact_.beginStep(u_, v_);
@@ -125,11 +130,8 @@ TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
 // crossing is interpolated from zero load, at (1 − 0)/(1.25 − 0) = 0.8 of the step for a load ratio of
 // 1.25, whether it stuck again in the step's finishStep or in the state update before.
 TEST_F(OneNode, ReStuckNodeCrossingInTheSameStepCountsFromAClearedLoad) {
-  update(4.1, 10.0);
-  net(4.1, 10.0);
   const double dt = 1e-3;
-  contact_.beginStep(u_, v_);
-  contact_.finishStep(u_, v_, dt);  // clears "just unstuck"
+  slideThroughOneStep(dt);
   contact_.updateStates(u_, v_, dt, 1.0);  // sliding: its load ratio here is µ_k/µ_s, not zero
   v_[0] = 2.0;
   contact_.beginStep(u_, v_);

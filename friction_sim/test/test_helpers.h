@@ -44,6 +44,17 @@ inline Scene coarseSliderScene(bool fast_forward = false) {
   return scene;
 }
 
+/// A chain of `blocks` blocks driven at the side 5 mm up with the whole torque term, so that every
+/// normal force depends on F_X.
+inline Scene torqueChainScene(int blocks) {
+  Scene scene;
+  scene.model = ModelKind::Chain1D;
+  scene.chain.blocks = blocks;
+  scene.chain.torque_share = 1.0;
+  scene.pusher.height = 0.005;
+  return scene;
+}
+
 /// A frictionless, unpushed elastic body integrated directly: u'' = F(u, u')/m.
 class FreeBody : public Dynamics {
  public:

@@ -237,11 +237,7 @@ TEST(SimulationStrips, FusedVerletStepEqualsTheUnfusedOneBitForBit) {
 TEST(SimulationStrips, FusedVerletStepOfALongChainEqualsTheUnfusedOneBitForBit) {
   // 10⁴ blocks driven at the side, with the torque term: three strips, each an interface strip
   // whose friction is applied as it is finished.
-  Scene chain;
-  chain.model = ModelKind::Chain1D;
-  chain.chain.blocks = 10000;
-  chain.chain.torque_share = 1.0;
-  chain.pusher.height = 0.005;
+  Scene chain = testing::torqueChainScene(10000);
   chain.stage.program = {StageSegment{StageMode::Velocity, 1.0}};
   chain.integrator.time_step = 0.5 * sceneStabilityLimit(chain);
   expectFusedVerletStepEqualsTheUnfusedOne(chain, 200);

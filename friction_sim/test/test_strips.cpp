@@ -82,12 +82,8 @@ TEST(LatticeStrips, StripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
 
 TEST(ChainStrips, SideDrivenStripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
   // 23 blocks, with tilt and the torque term, so that every normal force depends on F_X.
-  Scene scene;
-  scene.model = ModelKind::Chain1D;
-  scene.chain.blocks = 23;
+  Scene scene = testing::torqueChainScene(23);
   scene.chain.tilt = 0.3;
-  scene.chain.torque_share = 1.0;
-  scene.pusher.height = 0.005;
   const Chain1D chain(scene);
   Vector u(23);
   for (int i = 0; i < 23; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0);
