@@ -171,9 +171,9 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
         if b.get("run_type") == "iteration":
             value = b.get("ns_per_node_step", b.get("ns_per_block_step"))
             repetitions.setdefault(b["run_name"], []).append(value * 1e9 if value < 1e-3 else value)
-    for name, values in repetitions.items():
-        lines.append("| %s | %.2f | %.2f – %.2f |" % (name, statistics.median(values), min(values), max(values)))
     median = {name: statistics.median(values) for name, values in repetitions.items()}
+    for name, values in repetitions.items():
+        lines.append("| %s | %.2f | %.2f – %.2f |" % (name, median[name], min(values), max(values)))
     chain_fixed_cost = 57 * (median["chainStep/57"] - median["chainStep/1000"])
     lattice = {name: value for name, value in median.items() if "geometric" in name}
     largest = lattice.pop("latticeStep/geometric/1001/1001")
@@ -182,7 +182,7 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
               "4096 nodes (whole rows), and velocity Verlet's kick-and-drift and closing kick run on each strip "
               "while it is in the L2 cache (`StripHooks`). With separate passes a 10⁶-node step streamed its "
               "displacements, velocities and accelerations from memory five times and cost 6.6–9.4 ns per "
-              "node-step (a streaming update runs at about 60 GB/s on this machine). Now 10⁶ nodes cost %.2f ns, "
+              "node-step (a streaming update ran at about 60 GB/s on the machine of 2026-11-21). Now 10⁶ nodes cost %.2f ns, "
               "%.2f× the median of the smaller lattices (%.2f ns): what is left is reading and writing the state "
               "once per step. The chain driven at its side (pmma_1d_side) is swept the same way: F_X, and "
               "with it every block's normal force, is known once block 0 is prepared, so each strip's friction is "
