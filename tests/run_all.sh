@@ -6,6 +6,9 @@ here="$(cd "$(dirname "$0")/.." && pwd)"
 "$here/scripts/install_deps.sh" || exit 1
 "$here/scripts/build.sh" -j2 || { echo "0 passed, 1 failed"; exit 1; }
 source "$here/scripts/ros_env.sh"
+# The tests talk only to themselves: on loopback they need no resolvable host name (a fresh container
+# or chroot may not list its own in /etc/hosts) and listen on no network, as scripts/rig_launch.sh.
+export ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1
 results="$RIG_WS/build/test_results"
 rm -rf "$results"
 # catkin_make run_tests exits 0 even when tests fail: the verdict comes from catkin_test_results.
