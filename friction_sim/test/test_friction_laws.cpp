@@ -61,6 +61,27 @@ TEST_F(OneNode, StuckNodeCarriesWhateverHoldsItUpToStaticFriction) {
   EXPECT_EQ(contact_.state(0), ContactState::Stuck);
 }
 
+TEST_F(OneNode, ReadingsAfterStateUpdatesAreThoseOfTheLastFrictionPass) {
+  // Each update keeps its loads for the next one's crossing interpolation; the readings must not lag.
+  update(3.0, 10.0);
+  EXPECT_FALSE(update(2.0, 8.0));
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -2.0);
+  EXPECT_DOUBLE_EQ(contact_.normalForce(0), 8.0);
+  EXPECT_FALSE(update(1.0, 6.0));
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -1.0);
+  EXPECT_DOUBLE_EQ(contact_.normalForce(0), 6.0);
+}
+
+TEST_F(OneNode, FrictionReappliedAfterUnstickingUsesTheLastNormalForce) {
+  update(3.0, 8.0);  // an earlier update at another normal force
+  EXPECT_TRUE(update(4.1, 10.0));
+  Vector acceleration = Vector::Zero(1);
+  contact_.reapplyFriction(u_, 1.0, acceleration);
+  EXPECT_DOUBLE_EQ(acceleration[0], 4.1 - kMuK * 10.0);
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -kMuK * 10.0);
+  EXPECT_DOUBLE_EQ(contact_.normalForce(0), 10.0);
+}
+
 TEST_F(OneNode, UnsticksBeyondStaticFrictionAndSlidesAgainstKineticFriction) {
   EXPECT_TRUE(update(4.1, 10.0));
   EXPECT_EQ(contact_.state(0), ContactState::Sliding);

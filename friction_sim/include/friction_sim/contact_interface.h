@@ -10,6 +10,7 @@
 //    at rest) again when contact returns.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -66,8 +67,8 @@ class ContactInterface {
   /// Whether an equilibrium found with the interface pinned keeps every node stuck: each in contact and
   /// its pin's reaction, −trial.force at its dof, within µ_s·N.
   bool holdsPinned(const ForceEvaluation& trial) const;
-  double frictionForce(int node) const { return friction_[node]; }  ///< N, track on slider, x
-  double normalForce(int node) const { return normal_[node]; }      ///< N
+  double frictionForce(int node) const { return friction_[latest_slot_][node]; }  ///< N, track on slider, x
+  double normalForce(int node) const { return normal_[latest_slot_][node]; }      ///< N
   double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m
   /// m, the node's x displacement at the start of the last step (before any unstick catch-up).
   double stepStartPosition(int node) const { return start_u_[node]; }
@@ -99,7 +100,8 @@ class ContactInterface {
   /// At the end of a state update: its loads become the next update's previous ones.
   void rotateLoads();
   /// Records the interface entries of nodes [first_node, end_node) of `force_to_acceleration` (N, every
-  /// force but friction) as the other forces, computes friction_ from them, and overwrites those entries with accelerations (m/s²),
+  /// force but friction) as the other forces, computes the friction in the current slot from them and
+  /// the current slot's normal forces, and overwrites those entries with accelerations (m/s²),
   /// (other force + friction)·`inverse_mass`.
   void accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration,
                               int first_node, int end_node);
@@ -114,17 +116,17 @@ class ContactInterface {
   // if sliding (else 0); the law's µ_s and current sliding µ.
   std::vector<double> stuck_weight_, sliding_sign_, static_coefficient_, sliding_coefficient_;
   std::vector<double> anchor_;       ///< m, where a stuck node is held
-  std::vector<double> friction_;     ///< N
-  std::vector<double> normal_;       ///< N
+  // Friction (N) and normal force (N) of every node in two slots: the friction passes write the current
+  // one; the other keeps them as they were at the last state update, when the next update needs them
+  // to interpolate a threshold crossing. A stuck node's load is its friction against µ_s·N.
+  std::array<std::vector<double>, 2> friction_, normal_;
+  int current_slot_ = 0;
+  int latest_slot_ = 0;  ///< the slot written last: the current one, or the previous one after an update
   std::vector<double> other_force_;  ///< N, tangential force on the node from everything but friction
   std::vector<double> slip_origin_;  ///< m
   std::vector<char> just_unstuck_;
   std::vector<int> unstuck_last_step_, restuck_last_step_;
   std::vector<double> transition_fraction_;
-  // A stuck node's load at the last friction pass and at the last state update (for the crossing's
-  // interpolation): the force needed to hold it (N) and its threshold µ_s·N (N); 0 and 1 for a node
-  // that has just stuck.
-  std::vector<double> held_force_, threshold_, previous_held_force_, previous_threshold_;
   std::int64_t attention_ = 0;  ///< nodes that needed a state rule at the last friction pass
   // Start-of-step copies for re-stick interpolation and dissipation.
   std::vector<double> start_u_, start_v_, start_friction_;

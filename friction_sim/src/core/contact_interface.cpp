@@ -23,16 +23,14 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
   static_coefficient_.assign(n, 0.0);
   sliding_coefficient_.assign(n, 0.0);
   anchor_.assign(n, 0.0);
-  friction_.assign(n, 0.0);
-  normal_.assign(n, 0.0);
+  for (int slot = 0; slot < 2; ++slot) {
+    friction_[slot].assign(n, 0.0);
+    normal_[slot].assign(n, 0.0);
+  }
   other_force_.assign(n, 0.0);
   slip_origin_.assign(n, 0.0);
   just_unstuck_.assign(n, 0);
   transition_fraction_.assign(n, 1.0);
-  held_force_.assign(n, 0.0);
-  threshold_.assign(n, 1.0);
-  previous_held_force_.assign(n, 0.0);
-  previous_threshold_.assign(n, 1.0);
   start_u_.assign(n, 0.0);
   start_v_.assign(n, 0.0);
   start_friction_.assign(n, 0.0);
@@ -67,12 +65,6 @@ void ContactInterface::reset(const Vector& u) {
 }
 
 namespace {
-/// The force needed to hold a node where it is: its anchor spring's, or with k_T = 0 (rigid_weight 1)
-/// the reaction to every other force.
-inline double holdingForce(double k_t, double rigid_weight, double anchor, double x, double other) {
-  return k_t * (anchor - x) - rigid_weight * other;
-}
-
 /// The friction rules in branch-free form, so that the loops over the nodes vectorise: a stuck node
 /// carries what holds it (weight 1), a sliding one −µ·N·sgn(v) (sign ±1); a detached node has both
 /// weights zero.
@@ -82,34 +74,33 @@ inline double frictionOf(double stuck_weight, double holding, double sliding_coe
 }
 /// Turns every node's other force into its acceleration: records the force in `other`, the friction
 /// in `friction`, and overwrites `force_to_acceleration` with (other force + friction)·inverse_mass.
-/// Also records each node's load for the state update while the values are at hand: the force that
-/// holds it (a stuck node's friction: the anchor spring's force, or with k_T = 0 the rigid reaction)
-/// and its threshold µ_s·N. Returns how many nodes need one of the state rules: a stuck node in
-/// contact over its threshold, a node losing contact or a detached node regaining it.
-/// Branch-free and in one pass. A function of its own because GCC honours restrict only on parameters;
-/// without it the loop needs more run-time alias checks than GCC allows and is left scalar.
+/// The force that holds a stuck node is its anchor spring's or, with rigid sticking (k_T = 0), the
+/// reaction to every other force; then anchors and displacements are not read. Returns how many nodes
+/// need one of the state rules: a stuck node in contact whose holding force exceeds its threshold µ_s·N,
+/// a node losing contact or a detached node regaining it. Branch-free and in one pass. A function of its
+/// own because GCC honours restrict only on parameters; without it the loop needs more run-time alias
+/// checks than GCC allows and is left scalar.
+template <bool kRigid>
 std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* __restrict x,
                           const double* __restrict anchor, const double* __restrict normal,
                           const double* __restrict static_mu, const double* __restrict mu,
                           const double* __restrict stuck, const double* __restrict sign, double* __restrict other,
-                          double* __restrict friction, double* __restrict held, double* __restrict threshold,
-                          double* __restrict force_to_acceleration) {
-  const double rigid_weight = k_t > 0.0 ? 0.0 : 1.0;
+                          double* __restrict friction, double* __restrict force_to_acceleration) {
   // Counted in 64 bits, the width of every other lane of the loop: a mix of widths costs conversions.
   std::int64_t attention = 0;
   for (int node = 0; node < n; ++node) {
     const double force = force_to_acceleration[node];
     other[node] = force;
-    const double holding = holdingForce(k_t, rigid_weight, anchor[node], x[node], force);
+    // 0 − force rather than −force: a node with no force carries +0, not −0 (as a written result).
+    const double holding = kRigid ? 0.0 - force : k_t * (anchor[node] - x[node]);
     friction[node] = frictionOf(stuck[node], holding, mu[node], normal[node], sign[node]);
     force_to_acceleration[node] = (force + friction[node]) * inverse_mass;
-    held[node] = std::abs(friction[node]);
-    threshold[node] = static_mu[node] * normal[node];
     // 0/1 flags as doubles. The weights are 0 or 1: stuck + |sign| is 1 unless the node is detached.
     const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
     const double attached = stuck[node] + std::abs(sign[node]);
     const double holding_in_contact = stuck[node] * in_contact;
-    attention += (holding_in_contact > 0.0 && held[node] > threshold[node]) || in_contact != attached;
+    attention += (holding_in_contact > 0.0 && std::abs(friction[node]) > static_mu[node] * normal[node]) ||
+                 in_contact != attached;
   }
   return attention;
 }
@@ -120,22 +111,25 @@ void ContactInterface::accelerateWithFriction(const double* u, double inverse_ma
   const int offset = first_dof_ + first_node;
   // The ranges of one evaluation come in order from node 0.
   if (first_node == 0) attention_ = 0;
-  attention_ += frictionPass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
-                             normal_.data() + first_node, static_coefficient_.data() + first_node,
-                             sliding_coefficient_.data() + first_node, stuck_weight_.data() + first_node,
-                             sliding_sign_.data() + first_node, other_force_.data() + first_node,
-                             friction_.data() + first_node, held_force_.data() + first_node,
-                             threshold_.data() + first_node, force_to_acceleration + offset);
+  latest_slot_ = current_slot_;
+  auto* pass = k_t_ > 0.0 ? frictionPass<false> : frictionPass<true>;
+  attention_ += pass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
+                     normal_[current_slot_].data() + first_node, static_coefficient_.data() + first_node,
+                     sliding_coefficient_.data() + first_node, stuck_weight_.data() + first_node,
+                     sliding_sign_.data() + first_node, other_force_.data() + first_node,
+                     friction_[current_slot_].data() + first_node, force_to_acceleration + offset);
 }
 
 void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
                                      int first_node, int end_node) {
-  std::copy(raw.normal_force.data() + first_node, raw.normal_force.data() + end_node, normal_.data() + first_node);
+  std::copy(raw.normal_force.data() + first_node, raw.normal_force.data() + end_node,
+            normal_[current_slot_].data() + first_node);
   accelerateWithFriction(u.data(), inverse_mass, force.data(), first_node, end_node);
 }
 
 void ContactInterface::reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration) {
   std::copy_n(other_force_.data(), size(), acceleration.data() + first_dof_);
+  if (latest_slot_ != current_slot_) normal_[current_slot_] = normal_[latest_slot_];
   accelerateWithFriction(u.data(), inverse_mass, acceleration.data(), 0, size());
 }
 
@@ -147,7 +141,7 @@ void ContactInterface::beginStep(const Vector& u, const Vector& v) {
   // changes between the two, so the states it reads are still those of the step's start.
   if (sliding_count_ == 0) return;
   std::copy_n(v.data() + first_dof_, n, start_v_.data());
-  start_friction_ = friction_;
+  start_friction_ = friction_[latest_slot_];
 }
 
 bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
@@ -198,8 +192,7 @@ void ContactInterface::stick(int node, const Vector& u) {
 void ContactInterface::clearLoad(int node) {
   // Both buffers: a node that sticks again before the state update (finishStep) has its load at the
   // update's previous slot; one that sticks during it, at the slot that becomes the previous one.
-  held_force_[node] = previous_held_force_[node] = 0.0;
-  threshold_[node] = previous_threshold_[node] = 1.0;
+  friction_[0][node] = friction_[1][node] = 0.0;
 }
 
 void ContactInterface::startSliding(int node, int direction) {
@@ -212,8 +205,8 @@ void ContactInterface::startSliding(int node, int direction) {
 }
 
 void ContactInterface::rotateLoads() {
-  held_force_.swap(previous_held_force_);
-  threshold_.swap(previous_threshold_);
+  latest_slot_ = current_slot_;
+  current_slot_ ^= 1;
 }
 
 bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node_mass) {
@@ -226,9 +219,10 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     return false;
   }
   bool changed = false;
+  const int previous_slot = current_slot_ ^ 1;
   for (int node = 0; node < n; ++node) {
     const int dof = dofs_[node];
-    const double normal = normal_[node];
+    const double normal = normal_[current_slot_][node];
     if (normal <= 0.0) {
       if (state_[node] != ContactState::Detached) {
         if (state_[node] == ContactState::Stuck) dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
@@ -246,15 +240,21 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
       changed = true;
       continue;
     }
-    if (state_[node] != ContactState::Stuck || held_force_[node] <= threshold_[node]) continue;
-    const double ratio = held_force_[node] / threshold_[node];
-    const double previous_ratio = previous_held_force_[node] / previous_threshold_[node];
+    const double held = std::abs(friction_[current_slot_][node]);
+    const double threshold = static_coefficient_[node] * normal;
+    if (state_[node] != ContactState::Stuck || held <= threshold) continue;
+    const double ratio = held / threshold;
+    // Its load at the last update. A node stuck since then had contact there; a node that has just stuck
+    // had its load cleared (0), but perhaps no contact there.
+    const double previous_threshold = static_coefficient_[node] * normal_[previous_slot][node];
+    const double previous_ratio =
+        previous_threshold > 0.0 ? std::abs(friction_[previous_slot][node]) / previous_threshold : 0.0;
     transition_fraction_[node] =
         previous_ratio < 1.0 ? std::clamp((1.0 - previous_ratio) / (ratio - previous_ratio), 0.0, 1.0) : 0.0;
     // The spring energy of an elastic anchor is released into the slip.
     dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
     // It slides opposite to the friction that held it.
-    startSliding(node, friction_[node] > 0.0 ? -1 : 1);
+    startSliding(node, friction_[current_slot_][node] > 0.0 ? -1 : 1);
     const double late = (1.0 - transition_fraction_[node]) * dt;
     const double sliding_friction = -sliding_coefficient_[node] * normal * sliding_sign_[node];
     const double acceleration = (other_force_[node] + sliding_friction) / node_mass;
