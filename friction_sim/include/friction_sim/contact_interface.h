@@ -100,11 +100,11 @@ class ContactInterface {
   /// At the end of a state update: its loads become the next update's previous ones.
   void rotateLoads();
   /// Records the interface entries of nodes [first_node, end_node) of `force_to_acceleration` (N, every
-  /// force but friction) as the other forces, computes the friction in the current slot from them and
-  /// the current slot's normal forces, and overwrites those entries with accelerations (m/s²),
-  /// (other force + friction)·`inverse_mass`.
-  void accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration,
-                              int first_node, int end_node);
+  /// force but friction) as the other forces and `normal` (N, indexed by node) as the normal forces,
+  /// both in the current slot; computes the friction there from them, and overwrites those entries with
+  /// accelerations (m/s²), (other force + friction)·`inverse_mass`.
+  void accelerateWithFriction(const double* u, const double* normal, double inverse_mass,
+                              double* force_to_acceleration, int first_node, int end_node);
 
   std::unique_ptr<FrictionLaw> law_;
   std::vector<int> dofs_;

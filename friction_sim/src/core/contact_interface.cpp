@@ -73,16 +73,18 @@ inline double frictionOf(double stuck_weight, double holding, double sliding_coe
   return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
 }
 /// Turns every node's other force into its acceleration: records the force in `other`, the friction
-/// in `friction`, and overwrites `force_to_acceleration` with (other force + friction)·inverse_mass.
+/// in `friction` and, with kRecordNormal, the normal force in `recorded_normal`, and overwrites
+/// `force_to_acceleration` with (other force + friction)·inverse_mass.
 /// The force that holds a stuck node is its anchor spring's or, with rigid sticking (k_T = 0), the
 /// reaction to every other force; then anchors and displacements are not read. Returns how many nodes
 /// need one of the state rules: a stuck node in contact whose holding force exceeds its threshold µ_s·N,
 /// a node losing contact or a detached node regaining it. Branch-free and in one pass. A function of its
 /// own because GCC honours restrict only on parameters; without it the loop needs more run-time alias
 /// checks than GCC allows and is left scalar.
-template <bool kRigid>
+template <bool kRigid, bool kRecordNormal>
 std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* __restrict x,
                           const double* __restrict anchor, const double* __restrict normal,
+                          double* __restrict recorded_normal,
                           const double* __restrict static_mu, const double* __restrict mu,
                           const double* __restrict stuck, const double* __restrict sign, double* __restrict other,
                           double* __restrict friction, double* __restrict force_to_acceleration) {
@@ -91,6 +93,7 @@ std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* 
   for (int node = 0; node < n; ++node) {
     const double force = force_to_acceleration[node];
     other[node] = force;
+    if (kRecordNormal) recorded_normal[node] = normal[node];
     // 0 − force rather than −force: a node with no force carries +0, not −0 (as a written result).
     const double holding = kRigid ? 0.0 - force : k_t * (anchor[node] - x[node]);
     friction[node] = frictionOf(stuck[node], holding, mu[node], normal[node], sign[node]);
@@ -106,15 +109,18 @@ std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* 
 }
 }  // namespace
 
-void ContactInterface::accelerateWithFriction(const double* u, double inverse_mass, double* force_to_acceleration,
-                                              int first_node, int end_node) {
+void ContactInterface::accelerateWithFriction(const double* u, const double* normal, double inverse_mass,
+                                              double* force_to_acceleration, int first_node, int end_node) {
   const int offset = first_dof_ + first_node;
   // The ranges of one evaluation come in order from node 0.
   if (first_node == 0) attention_ = 0;
   latest_slot_ = current_slot_;
-  auto* pass = k_t_ > 0.0 ? frictionPass<false> : frictionPass<true>;
+  double* current_normal = normal_[current_slot_].data();
+  const bool rigid = k_t_ <= 0.0, record_normal = normal != current_normal;
+  auto* pass = rigid ? (record_normal ? frictionPass<true, true> : frictionPass<true, false>)
+                     : (record_normal ? frictionPass<false, true> : frictionPass<false, false>);
   attention_ += pass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
-                     normal_[current_slot_].data() + first_node, static_coefficient_.data() + first_node,
+                     normal + first_node, current_normal + first_node, static_coefficient_.data() + first_node,
                      sliding_coefficient_.data() + first_node, stuck_weight_.data() + first_node,
                      sliding_sign_.data() + first_node, other_force_.data() + first_node,
                      friction_[current_slot_].data() + first_node, force_to_acceleration + offset);
@@ -122,15 +128,12 @@ void ContactInterface::accelerateWithFriction(const double* u, double inverse_ma
 
 void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
                                      int first_node, int end_node) {
-  std::copy(raw.normal_force.data() + first_node, raw.normal_force.data() + end_node,
-            normal_[current_slot_].data() + first_node);
-  accelerateWithFriction(u.data(), inverse_mass, force.data(), first_node, end_node);
+  accelerateWithFriction(u.data(), raw.normal_force.data(), inverse_mass, force.data(), first_node, end_node);
 }
 
 void ContactInterface::reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration) {
   std::copy_n(other_force_.data(), size(), acceleration.data() + first_dof_);
-  if (latest_slot_ != current_slot_) normal_[current_slot_] = normal_[latest_slot_];
-  accelerateWithFriction(u.data(), inverse_mass, acceleration.data(), 0, size());
+  accelerateWithFriction(u.data(), normal_[latest_slot_].data(), inverse_mass, acceleration.data(), 0, size());
 }
 
 void ContactInterface::beginStep(const Vector& u, const Vector& v) {
