@@ -150,6 +150,19 @@ TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
 // A node that has just stuck starts from a cleared load: if it crosses µ_s·N in the next update, the
 // crossing is interpolated from zero load, at (1 − 0)/(1.25 − 0) = 0.8 of the step for a load ratio of
 // 1.25, whether it stuck again in the step's finishStep or in the state update before.
+TEST_F(OneNode, NodeUnstuckAtTheEndOfAnAllStuckStepStartedWhereItWasBeforeItsCatchUp) {
+  // With every node stuck rigidly, beginStep keeps no copy of the positions: none moves in the step.
+  u_[0] = 0.25;
+  contact_.reset(u_);
+  update(3.0, 10.0);
+  contact_.beginStep(u_, v_);
+  EXPECT_EQ(contact_.stepStartPosition(0, u_), 0.25);
+  net(4.1, 10.0);
+  EXPECT_TRUE(contact_.updateStates(u_, v_, 1e-3, 1.0));
+  EXPECT_GT(u_[0], 0.25);  // the slip it missed since crossing, 1/11 of the step before its end
+  EXPECT_EQ(contact_.stepStartPosition(0, u_), 0.25);
+}
+
 TEST_F(OneNode, ReStuckNodeCrossingInTheSameStepCountsFromAClearedLoad) {
   const double dt = 1e-3;
   slideThroughOneStep(dt);

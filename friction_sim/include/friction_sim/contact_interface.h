@@ -63,15 +63,18 @@ class ContactInterface {
   ContactState state(int node) const { return state_[node]; }
   int slidingCount() const { return sliding_count_; }
   /// True when every node is stuck (none sliding, none detached).
-  bool allStuck() const;
+  bool allStuck() const { return sliding_count_ == 0 && detached_count_ == 0; }
   /// Whether an equilibrium found with the interface pinned keeps every node stuck: each in contact and
   /// its pin's reaction, −trial.force at its dof, within µ_s·N.
   bool holdsPinned(const ForceEvaluation& trial) const;
   double frictionForce(int node) const { return friction_[latest_slot_][node]; }  ///< N, track on slider, x
   double normalForce(int node) const { return normal_[latest_slot_][node]; }      ///< N
   double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m
-  /// m, the node's x displacement at the start of the last step (before any unstick catch-up).
-  double stepStartPosition(int node) const { return start_u_[node]; }
+  /// m, the node's x displacement at the start of the last step (before any unstick catch-up), given
+  /// the displacements `u` after it.
+  double stepStartPosition(int node, const Vector& u) const {
+    return start_positions_kept_ || just_unstuck_[node] ? start_u_[node] : u[dofs_[node]];
+  }
   /// Nodes that unstuck (or slid off on returning contact) at the end of the last step.
   const std::vector<int>& unstuckLastStep() const { return unstuck_last_step_; }
   /// Nodes that re-stuck during the last step.
@@ -111,7 +114,7 @@ class ContactInterface {
   int first_dof_;
   double k_t_;
   std::vector<ContactState> state_;
-  int sliding_count_ = 0;
+  int sliding_count_ = 0, detached_count_ = 0;
   // Per node, in the form the friction loop needs: 1 if stuck (else 0); ±1 in the sliding direction
   // if sliding (else 0); the law's µ_s and current sliding µ.
   std::vector<double> stuck_weight_, sliding_sign_, static_coefficient_, sliding_coefficient_;
@@ -130,6 +133,11 @@ class ContactInterface {
   std::int64_t attention_ = 0;  ///< nodes that needed a state rule at the last friction pass
   // Start-of-step copies for re-stick interpolation and dissipation.
   std::vector<double> start_u_, start_v_, start_friction_;
+  // Whether the last step kept every node's start position. A rigidly stuck node does not move in a
+  // step (it has no velocity and an acceleration of exactly 0), so while every node sticks rigidly the
+  // copy is skipped: a node's start position is where it still is, or, for one that unsticks at the
+  // step's end, where it was before its catch-up.
+  bool start_positions_kept_ = true;
   double dissipation_ = 0.0;
 };
 

@@ -39,6 +39,7 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
 
 void ContactInterface::setState(int node, ContactState state) {
   sliding_count_ += (state == ContactState::Sliding) - (state_[node] == ContactState::Sliding);
+  detached_count_ += (state == ContactState::Detached) - (state_[node] == ContactState::Detached);
   state_[node] = state;
   stuck_weight_[node] = state == ContactState::Stuck ? 1.0 : 0.0;
   if (state != ContactState::Sliding) sliding_sign_[node] = 0.0;
@@ -62,6 +63,7 @@ void ContactInterface::reset(const Vector& u) {
   unstuck_last_step_.clear();
   restuck_last_step_.clear();
   dissipation_ = 0.0;
+  start_positions_kept_ = false;  // every node is stuck where it is
 }
 
 namespace {
@@ -139,7 +141,8 @@ void ContactInterface::reapplyFriction(const Vector& u, double inverse_mass, Vec
 void ContactInterface::beginStep(const Vector& u, const Vector& v) {
   restuck_last_step_.clear();
   const int n = size();
-  std::copy_n(u.data() + first_dof_, n, start_u_.data());
+  start_positions_kept_ = k_t_ > 0.0 || !allStuck();
+  if (start_positions_kept_) std::copy_n(u.data() + first_dof_, n, start_u_.data());
   // Only finishStep() reads the rest, and only after a step that began with a node sliding. No state
   // changes between the two, so the states it reads are still those of the step's start.
   if (sliding_count_ == 0) return;
@@ -262,6 +265,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     const double sliding_friction = -sliding_coefficient_[node] * normal * sliding_sign_[node];
     const double acceleration = (other_force_[node] + sliding_friction) / node_mass;
     const double catch_up = 0.5 * acceleration * late * late;
+    if (!start_positions_kept_) start_u_[node] = u[dof];
     u[dof] += catch_up;
     v[dof] += acceleration * late;
     dissipation_ -= sliding_friction * catch_up;
@@ -269,10 +273,6 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
   }
   rotateLoads();
   return changed;
-}
-
-bool ContactInterface::allStuck() const {
-  return std::all_of(state_.begin(), state_.end(), [](ContactState s) { return s == ContactState::Stuck; });
 }
 
 bool ContactInterface::holdsPinned(const ForceEvaluation& trial) const {

@@ -40,7 +40,7 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     for (int node : unstuck) sum += positions_[node];
     current_.nucleation_position = sum / unstuck.size();
     // Slip counts from where the nodes were before this step, including what unsticking caught up.
-    for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node));
+    for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
   }
   if (!in_event_) return false;
   for (int node : unstuck) {
