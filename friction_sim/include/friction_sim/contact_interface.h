@@ -27,7 +27,8 @@ class ContactInterface {
   /// `tangential_stiffness` is k_T (N/m); 0 makes stuck nodes rigid.
   ContactInterface(std::unique_ptr<FrictionLaw> law, const Model& model, double tangential_stiffness);
 
-  /// Sticks every node where it is, with no stored interfacial shear and slip measured from here.
+  /// Sticks every node where it is, with no stored interfacial shear and slip measured from here. The
+  /// interface must be at rest: a node sticks only with no velocity (so that a step does not move it).
   void reset(const Vector& u);
 
   /// `force` holds every force but friction on the degrees of freedom (N). Records the interface
