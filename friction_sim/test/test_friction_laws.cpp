@@ -147,9 +147,6 @@ TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
   EXPECT_DOUBLE_EQ(u_[0], 0.5 * acceleration * 0.25 * dt * dt);
 }
 
-// A node that has just stuck starts from a cleared load: if it crosses µ_s·N in the next update, the
-// crossing is interpolated from zero load, at (1 − 0)/(1.25 − 0) = 0.8 of the step for a load ratio of
-// 1.25, whether it stuck again in the step's finishStep or in the state update before.
 TEST_F(OneNode, NodeUnstuckAtTheEndOfAnAllStuckStepStartedWhereItWasBeforeItsCatchUp) {
   // With every node stuck rigidly, beginStep keeps no copy of the positions: none moves in the step.
   u_[0] = 0.25;
@@ -163,6 +160,9 @@ TEST_F(OneNode, NodeUnstuckAtTheEndOfAnAllStuckStepStartedWhereItWasBeforeItsCat
   EXPECT_EQ(contact_.stepStartPosition(0, u_), 0.25);
 }
 
+// A node that has just stuck starts from a cleared load: if it crosses µ_s·N in the next update, the
+// crossing is interpolated from zero load, at (1 − 0)/(1.25 − 0) = 0.8 of the step for a load ratio of
+// 1.25, whether it stuck again in the step's finishStep or in the state update before.
 TEST_F(OneNode, ReStuckNodeCrossingInTheSameStepCountsFromAClearedLoad) {
   const double dt = 1e-3;
   slideThroughOneStep(dt);

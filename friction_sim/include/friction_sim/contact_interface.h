@@ -125,7 +125,7 @@ class ContactInterface {
   // to interpolate a threshold crossing. A stuck node's load is its friction against µ_s·N.
   std::array<std::vector<double>, 2> friction_, normal_;
   int current_slot_ = 0;
-  int latest_slot_ = 0;  ///< the slot written last: the current one, or the previous one after an update
+  int latest_slot_ = 0;  ///< the slot the last friction pass wrote (the readings come from it)
   std::vector<double> other_force_;  ///< N, tangential force on the node from everything but friction
   std::vector<double> slip_origin_;  ///< m
   std::vector<char> just_unstuck_;

@@ -211,8 +211,7 @@ void ContactInterface::startSliding(int node, int direction) {
 }
 
 void ContactInterface::rotateLoads() {
-  latest_slot_ = current_slot_;
-  current_slot_ ^= 1;
+  current_slot_ ^= 1;  // the slot written last stays the one read (latest_slot_) until the next pass
 }
 
 bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node_mass) {
