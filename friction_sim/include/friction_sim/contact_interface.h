@@ -128,7 +128,7 @@ class ContactInterface {
   int latest_slot_ = 0;  ///< the slot the last friction pass wrote (the readings come from it)
   std::vector<double> other_force_;  ///< N, tangential force on the node from everything but friction
   std::vector<double> slip_origin_;  ///< m
-  std::vector<char> just_unstuck_;
+  std::vector<char> just_unstuck_;  ///< 1 for the nodes in unstuck_last_step_, else 0
   std::vector<int> unstuck_last_step_, restuck_last_step_;
   std::vector<double> transition_fraction_;
   std::int64_t attention_ = 0;  ///< nodes that needed a state rule at the last friction pass

@@ -103,7 +103,11 @@ class Simulation : public Dynamics {
   static constexpr int kMaxApproachJumps = 50;
   void refreshAfterStaticChange();
   void reapplyFriction();
+  /// Sets the stop reason once a stop condition holds. Called every step.
   void checkStop();
+  /// Composes the stop reason; kept out of checkStop, whose every-step test it would otherwise slow
+  /// with a string stream's set-up.
+  void recordStopReason(bool enough_events);
 
   Scene scene_;
   std::unique_ptr<Model> model_;
@@ -115,7 +119,8 @@ class Simulation : public Dynamics {
   double stability_limit_;
   double time_ = 0.0;
   long long steps_ = 0;
-  double inverse_mass_;  ///< 1/kg, of every node
+  double node_mass_;     ///< kg, of every node
+  double inverse_mass_;  ///< 1/kg
   Vector u_, v_, a_;
   double power_ = 0.0;  ///< W, viscous power at the current state
   /// The last force evaluation (friction excluded); its `force` stays empty, the forces go to a_.

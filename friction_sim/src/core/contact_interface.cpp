@@ -185,7 +185,7 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
       refreshCoefficients(node);
     }
   }
-  std::fill(just_unstuck_.begin(), just_unstuck_.end(), 0);
+  for (int node : unstuck_last_step_) just_unstuck_[node] = 0;  // the only nodes flagged
   return restuck;
 }
 
@@ -215,6 +215,7 @@ void ContactInterface::rotateLoads() {
 }
 
 bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node_mass) {
+  for (int node : unstuck_last_step_) just_unstuck_[node] = 0;  // also when no step came between updates
   unstuck_last_step_.clear();
   const int n = size();
   // The last friction pass recorded every node's load and whether any node needs one of the rules

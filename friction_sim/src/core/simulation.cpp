@@ -22,7 +22,8 @@ Simulation::Simulation(const Scene& scene, double stability_limit)
       detector_(*model_, scene_.instruments.front_fit_nodes),
       dt_(scene_.integrator.time_step),
       stability_limit_(stability_limit),
-      inverse_mass_(1.0 / model_->nodeMass()) {
+      node_mass_(model_->nodeMass()),
+      inverse_mass_(1.0 / node_mass_) {
   relaxToLoadedEquilibrium();
 }
 
@@ -44,7 +45,7 @@ void Simulation::relaxToLoadedEquilibrium() {
   contact_.reset(u_);
   external_reference_u_ = u_;
   power_ = acceleration(u_, v_, 0.0, a_);
-  if (contact_.updateStates(u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
+  if (contact_.updateStates(u_, v_, 0.0, node_mass_)) reapplyFriction();
   initial_elastic_ = model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_);
   if (scene_.integrator.fast_forward) {
     pinned_solver_ = std::make_unique<StaticSolver>(*model_, contact_.dofs());
@@ -56,7 +57,7 @@ void Simulation::refreshAfterStaticChange() {
   power_ = acceleration(u_, v_, time_, a_);
   // Refresh every node's held force and threshold for the next step's crossing interpolation (no time
   // passes).
-  if (contact_.updateStates(u_, v_, 0.0, model_->nodeMass())) reapplyFriction();
+  if (contact_.updateStates(u_, v_, 0.0, node_mass_)) reapplyFriction();
 }
 
 bool Simulation::relaxToStaticEquilibrium() {
@@ -70,7 +71,7 @@ bool Simulation::relaxToStaticEquilibrium() {
   auto potential = [&](const Vector& u) {
     return model_->elasticEnergy(u, stage_.position()) - model_->externalWork(external_reference_u_, u);
   };
-  viscous_dissipation_ += potential(u_) + 0.5 * model_->nodeMass() * v_.squaredNorm() - potential(relaxed);
+  viscous_dissipation_ += potential(u_) + 0.5 * node_mass_ * v_.squaredNorm() - potential(relaxed);
   u_ = relaxed;
   v_.setZero();
   refreshAfterStaticChange();
@@ -237,7 +238,7 @@ void Simulation::step() {
   ++steps_;
   pusher_work_ += 0.5 * (shear_start + evaluation_.shear_force) * (stage_.position() - stage_start);
   if (contact_.finishStep(u_, v_, dt_)) power_ = acceleration(u_, v_, time_, a_);
-  if (contact_.updateStates(u_, v_, dt_, model_->nodeMass())) reapplyFriction();
+  if (contact_.updateStates(u_, v_, dt_, node_mass_)) reapplyFriction();
   const bool was_in_event = detector_.inEvent();
   event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_,
                                  {shear_start, evaluation_.shear_force, evaluation_.normal_load});
@@ -254,9 +255,13 @@ void Simulation::run() {
 }
 
 void Simulation::checkStop() {
-  // Called every step: the message is only composed once a condition holds.
   const bool enough_events = scene_.stop.global_events > 0 && detector_.globalEventCount() >= scene_.stop.global_events;
-  if (!enough_events && time_ < scene_.stop.time && stage_.travel() < scene_.stop.stage_travel) return;
+  if (enough_events || !(time_ < scene_.stop.time) || !(stage_.travel() < scene_.stop.stage_travel)) {
+    recordStopReason(enough_events);
+  }
+}
+
+[[gnu::cold]] void Simulation::recordStopReason(bool enough_events) {
   std::ostringstream reason;
   if (enough_events) {
     reason << "reached " << detector_.globalEventCount() << " global slip event(s)";
@@ -349,7 +354,7 @@ EnergyBudget Simulation::energy() const {
   budget.work_in = pusher_work_ + external_work_closed_ + model_->externalWork(external_reference_u_, u_);
   budget.elastic = model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_);
   budget.initial_elastic = initial_elastic_;
-  budget.kinetic = 0.5 * model_->nodeMass() * v_.squaredNorm();
+  budget.kinetic = 0.5 * node_mass_ * v_.squaredNorm();
   budget.friction_dissipation = contact_.frictionDissipation();
   budget.viscous_dissipation = viscous_dissipation_;
   return budget;
