@@ -28,6 +28,7 @@ class OneNode : public ::testing::Test {
   /// (the acceleration of a 1 kg block).
   double net(double other, double normal) {
     raw_.force = Vector::Constant(1, other);
+    contact_.lendNormalStorage(raw_.normal_force);
     raw_.normal_force = Vector::Constant(1, normal);
     Vector force = raw_.force;
     contact_.applyFriction(raw_, u_, 1.0, force);
@@ -147,6 +148,21 @@ TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
   EXPECT_DOUBLE_EQ(u_[0], 0.5 * acceleration * 0.25 * dt * dt);
 }
 
+TEST_F(OneNode, CrossingIsInterpolatedFromTheLoadAtTheLastUpdateUnderItsOwnNormalForce) {
+  update(3.0, 8.0);  // load ratio 3/(µ_s·8)
+  net(4.1, 10.0);    // load ratio 4.1/(µ_s·10), in the evaluation's storage of the 8 N
+  ASSERT_TRUE(contact_.updateStates(u_, v_, 1e-3, 1.0));
+  const double before = 3.0 / (kMuS * 8.0), after = 4.1 / (kMuS * 10.0);
+  EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), (1.0 - before) / (after - before));
+}
+
+TEST_F(OneNode, RefusesNormalForcesRewrittenOverThoseOfTheLastUpdate) {
+  update(3.0, 8.0);
+  raw_.normal_force[0] = 10.0;  // in place: the 8 N the next update needs are lost
+  Vector force = raw_.force;
+  EXPECT_THROW(contact_.applyFriction(raw_, u_, 1.0, force), std::logic_error);
+}
+
 TEST_F(OneNode, NodeUnstuckAtTheEndOfAnAllStuckStepStartedWhereItWasBeforeItsCatchUp) {
   // With every node stuck rigidly, beginStep keeps no copy of the positions: none moves in the step.
   u_[0] = 0.25;
@@ -221,21 +237,25 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
   Vector u = Vector::Zero(1), v = Vector::Zero(1), force(1);
   contact.reset(u);
   ForceEvaluation raw;
-  raw.force = Vector::Constant(1, 2.0);
-  raw.normal_force = Vector::Constant(1, 10.0);
+  // An evaluation with 2 N of other force and 10 N of normal force, then friction on a block of mass
+  // 1/inverse_mass.
+  auto applyFriction = [&](double inverse_mass) {
+    raw.force = Vector::Constant(1, 2.0);
+    contact.lendNormalStorage(raw.normal_force);
+    raw.normal_force = Vector::Constant(1, 10.0);
+    force = raw.force;
+    contact.applyFriction(raw, u, inverse_mass, force);
+  };
   u[0] = 3e-3;  // anchor spring force −3 N, within µ_s·N = 4 N
-  force = raw.force;
-  contact.applyFriction(raw, u, 0.5, force);  // a 2 kg block
+  applyFriction(0.5);  // a 2 kg block
   EXPECT_DOUBLE_EQ(contact.frictionForce(0), -3.0);
   EXPECT_DOUBLE_EQ(force[0], (2.0 - 3.0) * 0.5);  // the block's acceleration, m/s²
   EXPECT_FALSE(contact.updateStates(u, v, 0.0, 2.0));
   EXPECT_DOUBLE_EQ(contact.anchorEnergy(u), 0.5 * k_t * 9e-6);
   u[0] = 5e-3;  // −5 N needed: unsticks
-  force = raw.force;
-  contact.applyFriction(raw, u, 1.0, force);
+  applyFriction(1.0);
   EXPECT_TRUE(contact.updateStates(u, v, 0.0, 1.0));
-  force = raw.force;
-  contact.applyFriction(raw, u, 1.0, force);
+  applyFriction(1.0);
   EXPECT_DOUBLE_EQ(contact.frictionForce(0), -kMuK * 10.0);
   contact.beginStep(u, v);
   contact.finishStep(u, v, 1e-3);
@@ -243,8 +263,7 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
   contact.beginStep(u, v);
   v[0] = -1.0;
   ASSERT_TRUE(contact.finishStep(u, v, 1e-3));
-  force = raw.force;
-  contact.applyFriction(raw, u, 1.0, force);
+  applyFriction(1.0);
   EXPECT_NEAR(contact.frictionForce(0), -kMuK * 10.0, 1e-12);
 }
 

@@ -31,10 +31,17 @@ class ContactInterface {
   /// interface must be at rest: a node sticks only with no velocity (so that a step does not move it).
   void reset(const Vector& u);
 
+  /// Call before evaluating into `normal_forces` the normal forces that applyFriction will read. The
+  /// interface reads them where the evaluation put them rather than copying them; after a state update
+  /// it keeps the update's normal forces (needed by the next update) by taking their storage in exchange
+  /// for spare storage of the same size. applyFriction refuses normal forces rewritten in place without
+  /// this call.
+  void lendNormalStorage(Vector& normal_forces);
   /// `force` holds every force but friction on the degrees of freedom (N). Records the interface
-  /// entries of nodes [first_node, end_node) and their normal forces for the state updates, and rewrites
-  /// those entries as accelerations (m/s²): (force + friction)·`inverse_mass`. The other entries are
-  /// left to the caller. Nodes are independent here, so a caller may go range by range.
+  /// entries of nodes [first_node, end_node) for the state updates, and rewrites those entries as
+  /// accelerations (m/s²): (force + friction)·`inverse_mass`. The other entries are left to the caller.
+  /// Nodes are independent here, so a caller may go range by range. `raw.normal_force` must stay
+  /// unchanged until the next evaluation (see lendNormalStorage).
   void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
                      int first_node, int end_node);
   /// The same for every interface node.
@@ -69,7 +76,7 @@ class ContactInterface {
   /// its pin's reaction, −trial.force at its dof, within µ_s·N.
   bool holdsPinned(const ForceEvaluation& trial) const;
   double frictionForce(int node) const { return friction_[latest_slot_][node]; }  ///< N, track on slider, x
-  double normalForce(int node) const { return normal_[latest_slot_][node]; }      ///< N
+  double normalForce(int node) const { return latest_normal_[node]; }             ///< N
   double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m
   /// m, the node's x displacement at the start of the last step (before any unstick catch-up), given
   /// the displacements `u` after it.
@@ -104,9 +111,9 @@ class ContactInterface {
   /// At the end of a state update: its loads become the next update's previous ones.
   void rotateLoads();
   /// Records the interface entries of nodes [first_node, end_node) of `force_to_acceleration` (N, every
-  /// force but friction) as the other forces and `normal` (N, indexed by node) as the normal forces,
-  /// both in the current slot; computes the friction there from them, and overwrites those entries with
-  /// accelerations (m/s²), (other force + friction)·`inverse_mass`.
+  /// force but friction) as the other forces and `normal` (N, indexed by node, all nodes) as the latest
+  /// normal forces; computes the friction in the current slot from them, and overwrites those entries
+  /// with accelerations (m/s²), (other force + friction)·`inverse_mass`.
   void accelerateWithFriction(const double* u, const double* normal, double inverse_mass,
                               double* force_to_acceleration, int first_node, int end_node);
 
@@ -120,12 +127,20 @@ class ContactInterface {
   // if sliding (else 0); the law's µ_s and current sliding µ.
   std::vector<double> stuck_weight_, sliding_sign_, static_coefficient_, sliding_coefficient_;
   std::vector<double> anchor_;       ///< m, where a stuck node is held
-  // Friction (N) and normal force (N) of every node in two slots: the friction passes write the current
-  // one; the other keeps them as they were at the last state update, when the next update needs them
-  // to interpolate a threshold crossing. A stuck node's load is its friction against µ_s·N.
-  std::array<std::vector<double>, 2> friction_, normal_;
+  // Friction (N) of every node in two slots: the friction passes write the current one; the other keeps
+  // it as it was at the last state update, when the next update needs it to interpolate a threshold
+  // crossing. A stuck node's load is its friction against µ_s·N.
+  std::array<std::vector<double>, 2> friction_;
   int current_slot_ = 0;
   int latest_slot_ = 0;  ///< the slot the last friction pass wrote (the readings come from it)
+  /// N, every node's normal force as the last friction pass read it, in the caller's evaluation.
+  const double* latest_normal_;
+  /// N, the normal forces of the last state update, once lendNormalStorage has taken them over; before
+  /// that, spare storage. Zero before the first update.
+  Vector update_normal_;
+  /// Whether a state update happened since the last lendNormalStorage: the update's normal forces are
+  /// then still in the evaluation's storage, and the next one must not overwrite them in place.
+  bool normals_to_take_ = false;
   std::vector<double> other_force_;  ///< N, tangential force on the node from everything but friction
   std::vector<double> slip_origin_;  ///< m
   std::vector<char> just_unstuck_;  ///< 1 for the nodes in unstuck_last_step_, else 0

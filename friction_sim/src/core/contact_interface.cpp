@@ -23,10 +23,9 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
   static_coefficient_.assign(n, 0.0);
   sliding_coefficient_.assign(n, 0.0);
   anchor_.assign(n, 0.0);
-  for (int slot = 0; slot < 2; ++slot) {
-    friction_[slot].assign(n, 0.0);
-    normal_[slot].assign(n, 0.0);
-  }
+  for (auto& slot : friction_) slot.assign(n, 0.0);
+  update_normal_ = Vector::Zero(n);
+  latest_normal_ = update_normal_.data();
   other_force_.assign(n, 0.0);
   slip_origin_.assign(n, 0.0);
   just_unstuck_.assign(n, 0);
@@ -74,19 +73,17 @@ inline double frictionOf(double stuck_weight, double holding, double sliding_coe
                          double sliding_sign) {
   return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
 }
-/// Turns every node's other force into its acceleration: records the force in `other`, the friction
-/// in `friction` and, with kRecordNormal, the normal force in `recorded_normal`, and overwrites
-/// `force_to_acceleration` with (other force + friction)·inverse_mass.
+/// Turns every node's other force into its acceleration: records the force in `other` and the friction
+/// in `friction`, and overwrites `force_to_acceleration` with (other force + friction)·inverse_mass.
 /// The force that holds a stuck node is its anchor spring's or, with rigid sticking (k_T = 0), the
 /// reaction to every other force; then anchors and displacements are not read. Returns how many nodes
 /// need one of the state rules: a stuck node in contact whose holding force exceeds its threshold µ_s·N,
 /// a node losing contact or a detached node regaining it. Branch-free and in one pass. A function of its
 /// own because GCC honours restrict only on parameters; without it the loop needs more run-time alias
 /// checks than GCC allows and is left scalar.
-template <bool kRigid, bool kRecordNormal>
+template <bool kRigid>
 std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* __restrict x,
                           const double* __restrict anchor, const double* __restrict normal,
-                          double* __restrict recorded_normal,
                           const double* __restrict static_mu, const double* __restrict mu,
                           const double* __restrict stuck, const double* __restrict sign, double* __restrict other,
                           double* __restrict friction, double* __restrict force_to_acceleration) {
@@ -95,7 +92,6 @@ std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* 
   for (int node = 0; node < n; ++node) {
     const double force = force_to_acceleration[node];
     other[node] = force;
-    if (kRecordNormal) recorded_normal[node] = normal[node];
     // 0 − force rather than −force: a node with no force carries +0, not −0 (as a written result).
     const double holding = kRigid ? 0.0 - force : k_t * (anchor[node] - x[node]);
     friction[node] = frictionOf(stuck[node], holding, mu[node], normal[node], sign[node]);
@@ -111,18 +107,27 @@ std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* 
 }
 }  // namespace
 
+void ContactInterface::lendNormalStorage(Vector& normal_forces) {
+  if (!normals_to_take_) return;
+  normals_to_take_ = false;
+  if (normal_forces.data() == latest_normal_) {
+    update_normal_.swap(normal_forces);
+  } else if (latest_normal_ != update_normal_.data()) {
+    update_normal_ = Eigen::Map<const Vector>(latest_normal_, size());
+  }
+  latest_normal_ = update_normal_.data();
+}
+
 void ContactInterface::accelerateWithFriction(const double* u, const double* normal, double inverse_mass,
                                               double* force_to_acceleration, int first_node, int end_node) {
   const int offset = first_dof_ + first_node;
   // The ranges of one evaluation come in order from node 0.
   if (first_node == 0) attention_ = 0;
   latest_slot_ = current_slot_;
-  double* current_normal = normal_[current_slot_].data();
-  const bool rigid = k_t_ <= 0.0, record_normal = normal != current_normal;
-  auto* pass = rigid ? (record_normal ? frictionPass<true, true> : frictionPass<true, false>)
-                     : (record_normal ? frictionPass<false, true> : frictionPass<false, false>);
+  latest_normal_ = normal;
+  auto* pass = k_t_ <= 0.0 ? frictionPass<true> : frictionPass<false>;
   attention_ += pass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
-                     normal + first_node, current_normal + first_node, static_coefficient_.data() + first_node,
+                     normal + first_node, static_coefficient_.data() + first_node,
                      sliding_coefficient_.data() + first_node, stuck_weight_.data() + first_node,
                      sliding_sign_.data() + first_node, other_force_.data() + first_node,
                      friction_[current_slot_].data() + first_node, force_to_acceleration + offset);
@@ -130,12 +135,17 @@ void ContactInterface::accelerateWithFriction(const double* u, const double* nor
 
 void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
                                      int first_node, int end_node) {
+  if (normals_to_take_ && raw.normal_force.data() == latest_normal_) {
+    throw std::logic_error(
+        "ContactInterface::applyFriction: normal forces evaluated over those of the last state update, which "
+        "the next update needs; call lendNormalStorage before the evaluation");
+  }
   accelerateWithFriction(u.data(), raw.normal_force.data(), inverse_mass, force.data(), first_node, end_node);
 }
 
 void ContactInterface::reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration) {
   std::copy_n(other_force_.data(), size(), acceleration.data() + first_dof_);
-  accelerateWithFriction(u.data(), normal_[latest_slot_].data(), inverse_mass, acceleration.data(), 0, size());
+  accelerateWithFriction(u.data(), latest_normal_, inverse_mass, acceleration.data(), 0, size());
 }
 
 void ContactInterface::beginStep(const Vector& u, const Vector& v) {
@@ -212,6 +222,7 @@ void ContactInterface::startSliding(int node, int direction) {
 
 void ContactInterface::rotateLoads() {
   current_slot_ ^= 1;  // the slot written last stays the one read (latest_slot_) until the next pass
+  normals_to_take_ = true;
 }
 
 bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node_mass) {
@@ -228,7 +239,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
   const int previous_slot = current_slot_ ^ 1;
   for (int node = 0; node < n; ++node) {
     const int dof = dofs_[node];
-    const double normal = normal_[current_slot_][node];
+    const double normal = latest_normal_[node];
     if (normal <= 0.0) {
       if (state_[node] != ContactState::Detached) {
         if (state_[node] == ContactState::Stuck) dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
@@ -252,7 +263,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     const double ratio = held / threshold;
     // Its load at the last update. A node stuck since then had contact there; a node that has just stuck
     // had its load cleared (0), but perhaps no contact there.
-    const double previous_threshold = static_coefficient_[node] * normal_[previous_slot][node];
+    const double previous_threshold = static_coefficient_[node] * update_normal_[node];
     const double previous_ratio =
         previous_threshold > 0.0 ? std::abs(friction_[previous_slot][node]) / previous_threshold : 0.0;
     transition_fraction_[node] =

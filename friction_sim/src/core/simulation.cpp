@@ -221,6 +221,7 @@ double Simulation::acceleration(const Vector& u, const Vector& v, double t, Vect
 }
 
 double Simulation::accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) {
+  contact_.lendNormalStorage(evaluation_.normal_force);
   AccelerationStrips strips(hooks, a, inverse_mass_, contact_, evaluation_, u);
   model_->evaluateInStrips(u, v, stage_.positionAfter(t - time_), a, evaluation_, strips, kStripNodes);
   return evaluation_.viscous_power;
