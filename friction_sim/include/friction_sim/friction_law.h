@@ -24,6 +24,9 @@ class FrictionLaw {
   virtual void onUnstick(int node) = 0;
   /// `node` slid by |slip| (m) during the last step.
   virtual void onSlip(int node, double slip) = 0;
+  /// True if every node has the same µ_s and the same sliding µ at all times: the friction loop then
+  /// reads two numbers rather than two per-node arrays.
+  virtual bool uniform() const { return false; }
 };
 
 /// Amontons–Coulomb: µ_s to start, constant µ_k while sliding.
@@ -35,6 +38,7 @@ class AmontonsCoulomb : public FrictionLaw {
   double slidingCoefficient(int) const override { return kinetic_; }
   void onUnstick(int) override {}
   void onSlip(int, double) override {}
+  bool uniform() const override { return true; }
 
  private:
   double static_, kinetic_;

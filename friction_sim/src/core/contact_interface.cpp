@@ -76,12 +76,13 @@ inline double frictionOf(double stuck_weight, double holding, double sliding_coe
 /// Turns every node's other force into its acceleration: records the force in `other` and the friction
 /// in `friction`, and overwrites `force_to_acceleration` with (other force + friction)·inverse_mass.
 /// The force that holds a stuck node is its anchor spring's or, with rigid sticking (k_T = 0), the
-/// reaction to every other force; then anchors and displacements are not read. Returns how many nodes
+/// reaction to every other force; then anchors and displacements are not read. With kUniform, every
+/// node has the first node's µ_s and sliding µ (FrictionLaw::uniform). Returns how many nodes
 /// need one of the state rules: a stuck node in contact whose holding force exceeds its threshold µ_s·N,
 /// a node losing contact or a detached node regaining it. Branch-free and in one pass. A function of its
 /// own because GCC honours restrict only on parameters; without it the loop needs more run-time alias
 /// checks than GCC allows and is left scalar.
-template <bool kRigid>
+template <bool kRigid, bool kUniform>
 std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* __restrict x,
                           const double* __restrict anchor, const double* __restrict normal,
                           const double* __restrict static_mu, const double* __restrict mu,
@@ -89,18 +90,22 @@ std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* 
                           double* __restrict friction, double* __restrict force_to_acceleration) {
   // Counted in 64 bits, the width of every other lane of the loop: a mix of widths costs conversions.
   std::int64_t attention = 0;
+  if (n <= 0) return attention;
+  const double uniform_static_mu = static_mu[0], uniform_mu = mu[0];
   for (int node = 0; node < n; ++node) {
+    const double node_static_mu = kUniform ? uniform_static_mu : static_mu[node];
+    const double node_mu = kUniform ? uniform_mu : mu[node];
     const double force = force_to_acceleration[node];
     other[node] = force;
     // 0 − force rather than −force: a node with no force carries +0, not −0 (as a written result).
     const double holding = kRigid ? 0.0 - force : k_t * (anchor[node] - x[node]);
-    friction[node] = frictionOf(stuck[node], holding, mu[node], normal[node], sign[node]);
+    friction[node] = frictionOf(stuck[node], holding, node_mu, normal[node], sign[node]);
     force_to_acceleration[node] = (force + friction[node]) * inverse_mass;
     // 0/1 flags as doubles. The weights are 0 or 1: stuck + |sign| is 1 unless the node is detached.
     const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
     const double attached = stuck[node] + std::abs(sign[node]);
     const double holding_in_contact = stuck[node] * in_contact;
-    attention += (holding_in_contact > 0.0 && std::abs(friction[node]) > static_mu[node] * normal[node]) ||
+    attention += (holding_in_contact > 0.0 && std::abs(friction[node]) > node_static_mu * normal[node]) ||
                  in_contact != attached;
   }
   return attention;
@@ -125,7 +130,9 @@ void ContactInterface::accelerateWithFriction(const double* u, const double* nor
   if (first_node == 0) attention_ = 0;
   latest_slot_ = current_slot_;
   latest_normal_ = normal;
-  auto* pass = k_t_ <= 0.0 ? frictionPass<true> : frictionPass<false>;
+  const bool uniform = law_->uniform();
+  auto* pass = k_t_ <= 0.0 ? (uniform ? frictionPass<true, true> : frictionPass<true, false>)
+                           : (uniform ? frictionPass<false, true> : frictionPass<false, false>);
   attention_ += pass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
                      normal + first_node, static_coefficient_.data() + first_node,
                      sliding_coefficient_.data() + first_node, stuck_weight_.data() + first_node,
