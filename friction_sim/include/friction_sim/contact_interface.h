@@ -123,9 +123,10 @@ class ContactInterface {
   double k_t_;
   std::vector<ContactState> state_;
   int sliding_count_ = 0, detached_count_ = 0;
-  // Per node, in the form the friction loop needs: 1 if stuck (else 0); ±1 in the sliding direction
-  // if sliding (else 0); the law's µ_s and current sliding µ.
-  std::vector<double> stuck_weight_, sliding_sign_, static_coefficient_, sliding_coefficient_;
+  // Per node, in the form the friction loop needs: its mode, 2 if stuck, the sliding direction
+  // ±1 if sliding, 0 if detached (one array rather than a stuck weight and a sign: the loop is bound by
+  // memory traffic); the law's µ_s and current sliding µ.
+  std::vector<double> friction_mode_, static_coefficient_, sliding_coefficient_;
   std::vector<double> anchor_;       ///< m, where a stuck node is held
   // Friction (N) of every node in two slots: the friction passes write the current one; the other keeps
   // it as it was at the last state update, when the next update needs it to interpolate a threshold

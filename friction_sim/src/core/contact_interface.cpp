@@ -7,6 +7,11 @@
 
 namespace friction {
 
+namespace {
+/// The friction mode of a stuck node (see ContactInterface::friction_mode_).
+constexpr double kStuckMode = 2.0;
+}  // namespace
+
 ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model& model,
                                    double tangential_stiffness)
     : law_(std::move(law)), k_t_(tangential_stiffness) {
@@ -18,8 +23,7 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
   }
   law_->resize(n);
   state_.assign(n, ContactState::Stuck);
-  stuck_weight_.assign(n, 1.0);
-  sliding_sign_.assign(n, 0.0);
+  friction_mode_.assign(n, kStuckMode);
   static_coefficient_.assign(n, 0.0);
   sliding_coefficient_.assign(n, 0.0);
   anchor_.assign(n, 0.0);
@@ -40,8 +44,7 @@ void ContactInterface::setState(int node, ContactState state) {
   sliding_count_ += (state == ContactState::Sliding) - (state_[node] == ContactState::Sliding);
   detached_count_ += (state == ContactState::Detached) - (state_[node] == ContactState::Detached);
   state_[node] = state;
-  stuck_weight_[node] = state == ContactState::Stuck ? 1.0 : 0.0;
-  if (state != ContactState::Sliding) sliding_sign_[node] = 0.0;
+  friction_mode_[node] = state == ContactState::Stuck ? kStuckMode : 0.0;  // startSliding sets the direction
 }
 
 void ContactInterface::refreshCoefficients(int node) {
@@ -68,7 +71,9 @@ void ContactInterface::reset(const Vector& u) {
 namespace {
 /// The friction rules in branch-free form, so that the loops over the nodes vectorise: a stuck node
 /// carries what holds it (weight 1), a sliding one −µ·N·sgn(v) (sign ±1); a detached node has both
-/// weights zero.
+/// weights zero. The weights are decoded from the node's friction mode.
+inline double stuckWeight(double mode) { return mode == kStuckMode ? 1.0 : 0.0; }
+inline double slidingSign(double mode) { return mode == kStuckMode ? 0.0 : mode; }
 inline double frictionOf(double stuck_weight, double holding, double sliding_coefficient, double normal,
                          double sliding_sign) {
   return stuck_weight * holding - sliding_coefficient * normal * sliding_sign;
@@ -86,7 +91,7 @@ template <bool kRigid, bool kUniform>
 std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* __restrict x,
                           const double* __restrict anchor, const double* __restrict normal,
                           const double* __restrict static_mu, const double* __restrict mu,
-                          const double* __restrict stuck, const double* __restrict sign, double* __restrict other,
+                          const double* __restrict mode, double* __restrict other,
                           double* __restrict friction, double* __restrict force_to_acceleration) {
   // Counted in 64 bits, the width of every other lane of the loop: a mix of widths costs conversions.
   std::int64_t attention = 0;
@@ -95,16 +100,17 @@ std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* 
   for (int node = 0; node < n; ++node) {
     const double node_static_mu = kUniform ? uniform_static_mu : static_mu[node];
     const double node_mu = kUniform ? uniform_mu : mu[node];
+    const double stuck = stuckWeight(mode[node]), sign = slidingSign(mode[node]);
     const double force = force_to_acceleration[node];
     other[node] = force;
     // 0 − force rather than −force: a node with no force carries +0, not −0 (as a written result).
     const double holding = kRigid ? 0.0 - force : k_t * (anchor[node] - x[node]);
-    friction[node] = frictionOf(stuck[node], holding, node_mu, normal[node], sign[node]);
+    friction[node] = frictionOf(stuck, holding, node_mu, normal[node], sign);
     force_to_acceleration[node] = (force + friction[node]) * inverse_mass;
     // 0/1 flags as doubles. The weights are 0 or 1: stuck + |sign| is 1 unless the node is detached.
     const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
-    const double attached = stuck[node] + std::abs(sign[node]);
-    const double holding_in_contact = stuck[node] * in_contact;
+    const double attached = stuck + std::abs(sign);
+    const double holding_in_contact = stuck * in_contact;
     attention += (holding_in_contact > 0.0 && std::abs(friction[node]) > node_static_mu * normal[node]) ||
                  in_contact != attached;
   }
@@ -135,8 +141,8 @@ void ContactInterface::accelerateWithFriction(const double* u, const double* nor
                            : (uniform ? frictionPass<false, true> : frictionPass<false, false>);
   attention_ += pass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
                      normal + first_node, static_coefficient_.data() + first_node,
-                     sliding_coefficient_.data() + first_node, stuck_weight_.data() + first_node,
-                     sliding_sign_.data() + first_node, other_force_.data() + first_node,
+                     sliding_coefficient_.data() + first_node, friction_mode_.data() + first_node,
+                     other_force_.data() + first_node,
                      friction_[current_slot_].data() + first_node, force_to_acceleration + offset);
 }
 
@@ -174,7 +180,7 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
       // Re-sticking below changes only this node, so state_ still holds the step's start here.
       if (state_[node] != ContactState::Sliding) continue;
       const int dof = dofs_[node];
-      const double direction = sliding_sign_[node];
+      const double direction = friction_mode_[node];  // ±1: it slides
       const double v_start = start_v_[node] * direction;
       const double v_end = v[dof] * direction;
       if (!just_unstuck_[node] && v_start > 0.0 && v_end <= 0.0) {
@@ -220,7 +226,7 @@ void ContactInterface::clearLoad(int node) {
 
 void ContactInterface::startSliding(int node, int direction) {
   setState(node, ContactState::Sliding);
-  sliding_sign_[node] = direction;
+  friction_mode_[node] = direction;
   just_unstuck_[node] = 1;
   law_->onUnstick(node);
   refreshCoefficients(node);
@@ -280,7 +286,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     // It slides opposite to the friction that held it.
     startSliding(node, friction_[current_slot_][node] > 0.0 ? -1 : 1);
     const double late = (1.0 - transition_fraction_[node]) * dt;
-    const double sliding_friction = -sliding_coefficient_[node] * normal * sliding_sign_[node];
+    const double sliding_friction = -sliding_coefficient_[node] * normal * friction_mode_[node];
     const double acceleration = (other_force_[node] + sliding_friction) / node_mass;
     const double catch_up = 0.5 * acceleration * late * late;
     if (!start_positions_kept_) start_u_[node] = u[dof];
