@@ -118,6 +118,7 @@ class ContactInterface {
                               double* force_to_acceleration, int first_node, int end_node);
 
   std::unique_ptr<FrictionLaw> law_;
+  bool uniform_law_;  ///< law_->uniform(), asked once
   std::vector<int> dofs_;
   int first_dof_;
   double k_t_;

@@ -14,7 +14,7 @@ constexpr double kStuckMode = 2.0;
 
 ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model& model,
                                    double tangential_stiffness)
-    : law_(std::move(law)), k_t_(tangential_stiffness) {
+    : law_(std::move(law)), uniform_law_(law_->uniform()), k_t_(tangential_stiffness) {
   const int n = model.interfaceNodeCount();
   for (int node = 0; node < n; ++node) dofs_.push_back(model.interfaceDof(node));
   first_dof_ = n > 0 ? dofs_[0] : 0;
@@ -136,9 +136,8 @@ void ContactInterface::accelerateWithFriction(const double* u, const double* nor
   if (first_node == 0) attention_ = 0;
   latest_slot_ = current_slot_;
   latest_normal_ = normal;
-  const bool uniform = law_->uniform();
-  auto* pass = k_t_ <= 0.0 ? (uniform ? frictionPass<true, true> : frictionPass<true, false>)
-                           : (uniform ? frictionPass<false, true> : frictionPass<false, false>);
+  auto* pass = k_t_ <= 0.0 ? (uniform_law_ ? frictionPass<true, true> : frictionPass<true, false>)
+                           : (uniform_law_ ? frictionPass<false, true> : frictionPass<false, false>);
   attention_ += pass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
                      normal + first_node, static_coefficient_.data() + first_node,
                      sliding_coefficient_.data() + first_node, friction_mode_.data() + first_node,
