@@ -72,6 +72,8 @@ class Chain1D : public Model {
                           ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const;
   /// w_i of blocks [first, first + count) at the given F_X (N), before clamping at 0.
   auto normalForceExpression(double shear_force, int first, int count) const;
+  /// Writes the normal forces (N), w_i clamped at 0, of blocks [first, first + count) into `normal_forces`.
+  void writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const;
   /// N, c = 2·g·h·F_X/(L·Σξ²), the friction-induced torque's share of each block's normal force per ξ.
   double torqueCoefficient(double shear_force) const;
 

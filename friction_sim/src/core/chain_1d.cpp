@@ -49,6 +49,16 @@ auto Chain1D::normalForceExpression(double shear_force, int first, int count) co
   return normal_force_ / n_ * tilt_factor_.segment(first, count) + torqueCoefficient(shear_force) * xi_.segment(first, count);
 }
 
+inline void Chain1D::writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const {
+  if (tilt_ == 0.0) {
+    // The tilt factor is then exactly 1: the same numbers without reading it.
+    normal_forces.segment(first, count) =
+        (normal_force_ / n_ + torqueCoefficient(shear_force) * xi_.segment(first, count)).max(0.0);
+  } else {
+    normal_forces.segment(first, count) = normalForceExpression(shear_force, first, count).max(0.0);
+  }
+}
+
 std::vector<double> Chain1D::normalForces(double shear_force) const {
   const Eigen::ArrayXd w = normalForceExpression(shear_force, 0, n_);
   return {w.begin(), w.end()};
@@ -95,7 +105,8 @@ void Chain1D::evaluateTopDriven(const Vector& u, const Vector& v, double stage_p
   out.shear_force = shear;
   out.normal_load = normal_force_;
   out.viscous_power = eta_ * (v.tail(n_ - 1).array() - v.head(n_ - 1).array()).square().sum();
-  out.normal_force = normalForceExpression(shear, 0, n_).max(0.0);
+  out.normal_force.resize(n_);
+  writeNormalForces(shear, 0, n_, out.normal_force);
 }
 
 void Chain1D::evaluateSideDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
@@ -129,7 +140,7 @@ void Chain1D::evaluateSideDriven(const Vector& u, const Vector& v, double stage_
     if (end == n_ && first < n_ - 1) f[n_ - 1] = -tension(n_ - 2);
     if (first == 0) f[0] += shear;
     const int count = end - first;
-    out.normal_force.segment(first, count) = normalForceExpression(shear, first, count).max(0.0);
+    writeNormalForces(shear, first, count, out.normal_force);
     if (bonds_end > first) {
       squared_velocity_differences +=
           (v.segment(first + 1, bonds_end - first).array() - v.segment(first, bonds_end - first).array()).square().sum();
