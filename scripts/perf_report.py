@@ -189,10 +189,11 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
               "applied as soon as the strip is finished (driven from the top, F_X is a sum over every block and the "
               "chain keeps separate passes). At 57 blocks a step costs %.0f ns more than 57 blocks' share of a "
               "10³-block step: the fixed costs of its short vector loops and of the step's bookkeeping. At 10⁵ "
-              "blocks it streams 13 arrays of one number per block once per step. It writes 7: displacements, "
-              "velocities, forces turned accelerations, the normal forces, the interface's record of them, its "
-              "friction and the other forces. It only reads the interface's 4 weights and the 2 of the normal-force "
-              "profile." % (largest, largest / smaller, smaller, chain_fixed_cost)]
+              "blocks it streams 9 arrays of one number per block once per step. It writes 6: displacements, "
+              "velocities, forces turned accelerations, the normal forces, the friction and the other forces. It only "
+              "reads each node's friction mode (stuck, sliding direction or detached) and the 2 of the normal-force "
+              "profile (1 without tilt): Amontons–Coulomb's µ_s and µ_k are read as two numbers, and with rigid "
+              "sticking the anchors are not read." % (largest, largest / smaller, smaller, chain_fixed_cost)]
     lines += ["", "## Whole runs: wall time and peak memory", "",
               "Each in a fresh process; wall time includes building the model, the stability limit and the loading "
               "solve.", "", "| run | wall (s) | peak memory (MB) |", "|---|---|---|"]
