@@ -156,6 +156,19 @@ TEST_F(OneNode, CrossingIsInterpolatedFromTheLoadAtTheLastUpdateUnderItsOwnNorma
   EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), (1.0 - before) / (after - before));
 }
 
+TEST_F(OneNode, KeepsTheLastUpdatesNormalForceWhenTheNextEvaluationUsesOtherStorage) {
+  update(3.0, 8.0);
+  ForceEvaluation other;  // not the storage the interface read the 8 N from: it copies them
+  other.force = Vector::Constant(1, 4.1);
+  contact_.lendNormalStorage(other.normal_force);
+  other.normal_force = Vector::Constant(1, 10.0);
+  Vector force = other.force;
+  contact_.applyFriction(other, u_, 1.0, force);
+  ASSERT_TRUE(contact_.updateStates(u_, v_, 1e-3, 1.0));
+  const double before = 3.0 / (kMuS * 8.0), after = 4.1 / (kMuS * 10.0);
+  EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), (1.0 - before) / (after - before));
+}
+
 TEST_F(OneNode, RefusesNormalForcesRewrittenOverThoseOfTheLastUpdate) {
   update(3.0, 8.0);
   raw_.normal_force[0] = 10.0;  // in place: the 8 N the next update needs are lost
