@@ -110,7 +110,7 @@ def main():
     # Five repetitions, reported as their median and range: this shared machine's speed varies by up
     # to a third from one minute to the next.
     bench = subprocess.run([BENCH, "--benchmark_format=json", "--benchmark_min_time=0.5",
-                            "--benchmark_repetitions=5", "--benchmark_filter=latticeStep|chainStep"],
+                            "--benchmark_repetitions=5", "--benchmark_filter=latticeStep|chainStep|stateStream"],
                            check=True, capture_output=True, text=True).stdout
     bench = json.loads(bench)
     whole = [measured_run("default experiment (pmma_2d, first global event + 5 cycles)",
@@ -175,6 +175,7 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
     for name, values in repetitions.items():
         lines.append("| %s | %.2f | %.2f – %.2f |" % (name, median[name], min(values), max(values)))
     chain_fixed_cost = 57 * (median["chainStep/57"] - median["chainStep/1000"])
+    stream_small, stream_large = median["stateStream/1767"], median["stateStream/1002001"]
     lattice = {name: value for name, value in median.items() if "geometric" in name}
     largest = lattice.pop("latticeStep/geometric/1001/1001")
     smaller = statistics.median(lattice.values())
@@ -182,9 +183,13 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
               "4096 nodes (whole rows), and velocity Verlet's kick-and-drift and closing kick run on each strip "
               "while it is in the L2 cache (`StripHooks`). With separate passes a 10⁶-node step streamed its "
               "displacements, velocities and accelerations from memory five times and cost 6.6–9.4 ns per "
-              "node-step (a streaming update ran at about 60 GB/s on the machine of 2026-11-21). Now 10⁶ nodes cost %.2f ns, "
-              "%.2f× the median of the smaller lattices (%.2f ns): what is left is reading and writing the state "
-              "once per step. The chain driven at its side (pmma_1d_side) is swept the same way: F_X, and "
+              "node-step. Now 10⁶ nodes cost %.2f ns, %.2f× the median of the smaller lattices (%.2f ns). Velocity "
+              "Verlet's memory traffic alone, each node's displacements, velocities and accelerations read and "
+              "written once with a force that costs nothing (`stateStream`), costs %.2f ns per node at 10⁶ nodes "
+              "(%.0f GB/s) and %.2f ns in cache: the large lattice's step hides its traffic behind the bond "
+              "arithmetic only in part (%.2f ns of %.2f are not hidden). A flat cost needs that traffic hidden or "
+              "cut, by two steps per sweep (temporal blocking) or by storing half-step velocities in place of "
+              "the accelerations; neither is done. The chain driven at its side (pmma_1d_side) is swept the same way: F_X, and "
               "with it every block's normal force, is known once block 0 is prepared, so each strip's friction is "
               "applied as soon as the strip is finished (driven from the top, F_X is a sum over every block and the "
               "chain keeps separate passes). At 57 blocks a step costs %.0f ns more than 57 blocks' share of a "
@@ -193,7 +198,8 @@ def write_report(reference, results, slow, sizes, bench, whole, sensitivity):
               "velocities, forces turned accelerations, the normal forces, the friction and the other forces. It only "
               "reads each node's friction mode (stuck, sliding direction or detached) and the 2 of the normal-force "
               "profile (1 without tilt): Amontons–Coulomb's µ_s and µ_k are read as two numbers, and with rigid "
-              "sticking the anchors are not read." % (largest, largest / smaller, smaller, chain_fixed_cost)]
+              "sticking the anchors are not read." % (largest, largest / smaller, smaller, stream_large, 96.0 / stream_large,
+                                                   stream_small, largest - smaller, stream_large, chain_fixed_cost)]
     lines += ["", "## Whole runs: wall time and peak memory", "",
               "Each in a fresh process; wall time includes building the model, the stability limit and the loading "
               "solve.", "", "| run | wall (s) | peak memory (MB) |", "|---|---|---|"]

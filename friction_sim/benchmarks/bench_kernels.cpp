@@ -1,8 +1,13 @@
 // Google Benchmark of the explicit step, the hot loop: ns per node-step of the 2D lattice and per
-// block-step of the 1D chain, over system sizes. Run: .build/devel/lib/friction_sim/bench_kernels
+// block-step of the 1D chain, over system sizes, and the memory floor of a lattice step (stateStream).
+// Run: .build/devel/lib/friction_sim/bench_kernels
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/scene_io.h"
@@ -24,10 +29,28 @@ Scene latticeScene(int nx, int nz) {
   return scene;
 }
 
+/// Google Benchmark calls a case once per trial of its iteration count, and building a 10⁶-node
+/// simulation (loading solve, stability limit) takes about half a minute, so a case builds its
+/// simulation once and steps it on. Its state is a held equilibrium, so every step costs the same.
+Simulation& reusedSimulation(const std::string& key, const std::function<std::unique_ptr<Simulation>()>& build) {
+  static std::string built_for;
+  static std::unique_ptr<Simulation> simulation;
+  if (key != built_for || !simulation) {
+    simulation.reset();  // before building the next, so that two large lattices never coexist
+    simulation = build();
+    built_for = key;
+  }
+  return *simulation;
+}
+
 void latticeStep(benchmark::State& state, SpringForm form) {
-  Scene scene = latticeScene(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  scene.lattice.spring_form = form;
-  Simulation simulation(scene);
+  const std::string key = "lattice/" + std::to_string(static_cast<int>(form)) + "/" +
+                          std::to_string(state.range(0)) + "/" + std::to_string(state.range(1));
+  Simulation& simulation = reusedSimulation(key, [&] {
+    Scene scene = latticeScene(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+    scene.lattice.spring_form = form;
+    return std::make_unique<Simulation>(scene);
+  });
   const double nodes = static_cast<double>(state.range(0) * state.range(1));
   for (auto _ : state) simulation.step();
   state.counters["ns_per_node_step"] =
@@ -40,19 +63,52 @@ BENCHMARK_CAPTURE(latticeStep, linearised, SpringForm::Linearised)->Args({57, 31
     ->Unit(benchmark::kMicrosecond);
 
 void chainStep(benchmark::State& state) {
-  Scene scene;
-  scene.model = ModelKind::Chain1D;
-  scene.chain.blocks = static_cast<int>(state.range(0));
-  scene.stage.program = {StageSegment{StageMode::Hold, 0.0}};
-  scene.stop.time = 1e9;
-  const double stability_limit = sceneStabilityLimit(scene);
-  scene.integrator.time_step = 0.5 * stability_limit;
-  Simulation simulation(scene, stability_limit);
+  Simulation& simulation = reusedSimulation("chain/" + std::to_string(state.range(0)), [&] {
+    Scene scene;
+    scene.model = ModelKind::Chain1D;
+    scene.chain.blocks = static_cast<int>(state.range(0));
+    scene.stage.program = {StageSegment{StageMode::Hold, 0.0}};
+    scene.stop.time = 1e9;
+    const double stability_limit = sceneStabilityLimit(scene);
+    scene.integrator.time_step = 0.5 * stability_limit;
+    return std::make_unique<Simulation>(scene, stability_limit);
+  });
   for (auto _ : state) simulation.step();
   state.counters["ns_per_block_step"] = benchmark::Counter(
       static_cast<double>(state.range(0)) * state.iterations() * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(chainStep)->Arg(57)->Arg(1000)->Arg(100000)->Unit(benchmark::kMicrosecond);
+
+/// The memory floor of a lattice step: velocity Verlet's traffic alone, each node's displacements,
+/// velocities and accelerations (6 numbers) read and written once, with a force that costs nothing.
+/// Compared with latticeStep at the same size it tells how much of a large lattice's step is waiting
+/// for memory.
+void stateStream(benchmark::State& state) {
+  const std::size_t nodes = static_cast<std::size_t>(state.range(0));
+  std::vector<double> ux(nodes, 1e-6), uz(nodes, -1e-6), vx(nodes, 0.0), vz(nodes, 0.0), ax(nodes, 0.0), az(nodes, 0.0);
+  const double dt = 1e-8, half_dt = 0.5 * dt, stiffness_per_mass = 1e10;
+  for (auto _ : state) {
+    double* __restrict pux = ux.data();
+    double* __restrict puz = uz.data();
+    double* __restrict pvx = vx.data();
+    double* __restrict pvz = vz.data();
+    double* __restrict pax = ax.data();
+    double* __restrict paz = az.data();
+    for (std::size_t i = 0; i < nodes; ++i) {
+      const double half_vx = pvx[i] + half_dt * pax[i], half_vz = pvz[i] + half_dt * paz[i];
+      pux[i] += dt * half_vx;
+      puz[i] += dt * half_vz;
+      pax[i] = -stiffness_per_mass * pux[i];
+      paz[i] = -stiffness_per_mass * puz[i];
+      pvx[i] = half_vx + half_dt * pax[i];
+      pvz[i] = half_vz + half_dt * paz[i];
+    }
+    benchmark::ClobberMemory();
+  }
+  state.counters["ns_per_node_step"] = benchmark::Counter(static_cast<double>(nodes) * state.iterations() * 1e-9,
+                                                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(stateStream)->Arg(57 * 31)->Arg(1001 * 1001)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace friction
