@@ -49,13 +49,16 @@ auto Chain1D::normalForceExpression(double shear_force, int first, int count) co
   return normal_force_ / n_ * tilt_factor_.segment(first, count) + torqueCoefficient(shear_force) * xi_.segment(first, count);
 }
 
-inline void Chain1D::writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const {
+void Chain1D::writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const {
+  const double torque = torqueCoefficient(shear_force);
+  auto write = [&](const auto& load_share) {
+    normal_forces.segment(first, count) = (load_share + torque * xi_.segment(first, count)).max(0.0);
+  };
+  // Without tilt the tilt profile is exactly 1: the same numbers without reading it.
   if (tilt_ == 0.0) {
-    // The tilt factor is then exactly 1: the same numbers without reading it.
-    normal_forces.segment(first, count) =
-        (normal_force_ / n_ + torqueCoefficient(shear_force) * xi_.segment(first, count)).max(0.0);
+    write(normal_force_ / n_);
   } else {
-    normal_forces.segment(first, count) = normalForceExpression(shear_force, first, count).max(0.0);
+    write(normal_force_ / n_ * tilt_factor_.segment(first, count));
   }
 }
 
