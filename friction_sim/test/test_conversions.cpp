@@ -102,7 +102,7 @@ TEST(Conversions, CommandsRoundTripWithTheirTime) {
 }
 
 TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
-  const Stage stage(StageSpec{});
+  const Stage stage(StageSpec{}, 1e-7);
   friction_msgs::StageCommand msg;
   msg.mode = friction_msgs::StageCommand::VELOCITY;
   msg.speed = std::nan("");

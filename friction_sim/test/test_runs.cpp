@@ -158,8 +158,8 @@ TEST(StageProgram, HoldThenDriveThenMoveToATarget) {
   StageSpec spec;
   spec.program = {StageSegment{StageMode::Hold, 0.0, 0.0, 0.01}, StageSegment{StageMode::Velocity, 1e-3, 0.0, 0.01},
                   StageSegment{StageMode::Position, 2e-3, 0.0}};
-  Stage stage(spec);
   const double dt = 1e-4;
+  Stage stage(spec, dt);
   for (int i = 0; i < 100; ++i) stage.advance(dt);
   EXPECT_DOUBLE_EQ(stage.position(), 0.0);
   for (int i = 0; i < 100; ++i) stage.advance(dt);
@@ -171,8 +171,22 @@ TEST(StageProgram, HoldThenDriveThenMoveToATarget) {
   EXPECT_NEAR(stage.travel(), 2e-5, 1e-12);
 }
 
+TEST(StageProgram, AJumpEndingShortOfTheSegmentsEndDoesNotEndIt) {
+  // Fast-forward stops a jump short of a threshold, here 0.4 ms before the end of a 4 ms segment: the
+  // segment goes on (it switched on half the jump's length before). It ends on the step nearest to its end.
+  StageSpec spec;
+  spec.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.004}, StageSegment{StageMode::Hold, 0.0, 0.0, 0.002}};
+  const double dt = 2e-7;
+  Stage stage(spec, dt);
+  stage.advance(0.0036);
+  EXPECT_EQ(stage.current().mode, StageMode::Velocity);
+  stage.advance(0.0004 - 0.4 * dt);
+  EXPECT_EQ(stage.current().mode, StageMode::Hold);
+  EXPECT_NEAR(stage.position(), 1.6e-5, 0.4 * dt * 4e-3 + 1e-18);
+}
+
 TEST(StageProgram, BadCommandsAreRefusedAndChangeNothing) {
-  Stage stage(StageSpec{});
+  Stage stage(StageSpec{}, 1e-7);
   const double speed_before = stage.velocity();
   EXPECT_NE(stage.command({StageMode::Velocity, std::nan(""), 0.0}).find("finite"), std::string::npos);
   EXPECT_NE(stage.command({StageMode::Velocity, 5.0, 0.0}).find("max_speed"), std::string::npos);

@@ -16,7 +16,9 @@ struct StageCommand {
 
 class Stage {
  public:
-  explicit Stage(const StageSpec& spec);
+  /// `time_step` (s) is the run's: a program segment ends on the step that ends nearest to its end
+  /// (immune to round-off in the sum of the steps), also when the stage is advanced by a longer jump.
+  Stage(const StageSpec& spec, double time_step);
 
   double position() const { return position_; }  ///< m, X_s
   double velocity() const;                        ///< m/s, dX_s/dt now
@@ -31,8 +33,9 @@ class Stage {
   std::string checkCommand(const StageCommand& command) const;
   /// Replaces the program by `command`; returns the refusal reason, or empty if applied.
   std::string command(const StageCommand& command);
-  /// Moves the stage by one time step dt (s).
-  void advance(double dt);
+  /// Moves the stage on by `duration` (s): one time step, or a fast-forward jump that ends at or before
+  /// the end of the current segment.
+  void advance(double duration);
 
  private:
   void enterSegment(std::size_t index);
@@ -41,6 +44,7 @@ class Stage {
   StageCommand current_;
   std::size_t segment_ = 0;
   bool following_program_ = true;
+  double time_step_;              ///< s, the run's time step
   double segment_elapsed_ = 0.0;  ///< s
   double position_ = 0.0;
   double travel_ = 0.0;

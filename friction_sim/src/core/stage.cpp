@@ -7,7 +7,7 @@
 
 namespace friction {
 
-Stage::Stage(const StageSpec& spec) : spec_(spec) { enterSegment(0); }
+Stage::Stage(const StageSpec& spec, double time_step) : spec_(spec), time_step_(time_step) { enterSegment(0); }
 
 void Stage::enterSegment(std::size_t index) {
   segment_ = index;
@@ -69,14 +69,15 @@ std::string Stage::command(const StageCommand& command) {
   return reason;
 }
 
-void Stage::advance(double dt) {
-  const double next = positionAfter(dt);
+void Stage::advance(double duration) {
+  const double next = positionAfter(duration);
   travel_ += std::abs(next - position_);
   position_ = next;
   if (!following_program_) return;
-  segment_elapsed_ += dt;
-  // Switch on the step that ends nearest to the segment's end, immune to round-off in the sum.
-  if (segment_elapsed_ + 0.5 * dt >= spec_.program[segment_].duration && segment_ + 1 < spec_.program.size()) {
+  segment_elapsed_ += duration;
+  // Half a time step, not half of `duration`: a jump stopped short of a threshold may end well before
+  // the segment does, and the segment must not be cut short by half the jump.
+  if (segment_elapsed_ + 0.5 * time_step_ >= spec_.program[segment_].duration && segment_ + 1 < spec_.program.size()) {
     enterSegment(segment_ + 1);
   }
 }
