@@ -49,6 +49,46 @@ TEST(FastForward, AgreesWithFullDynamicsOnPrecursorsAndFirstGlobalEvent) {
   EXPECT_LT(std::abs(fast.energy().relativeResidual()), 1e-4);
 }
 
+TEST(FastForward, GoesOnWithTheTrailingEdgeLiftedAndAgreesWithFullDynamics) {
+  // Pushed at the top, the trailing corner comes off the track during the loading; fast-forward goes on
+  // along the static path with it free (its foundation spring taken out of the factor) and stops where
+  // it would land as at a threshold. Every event with an extent is the same as in full dynamics (arrest
+  // point, onset force to 0.2 %). Measured: onsets within 0.05 %, 4223 steps against 249755 (57068
+  // when every lifted stretch was integrated). Left: at a lifted corner's landing, with the ring-down
+  // skipped, fast-forward records single-node slips that full dynamics does not (29 events against 23).
+  Scene scene = testing::coarseSliderScene(false);
+  scene.pusher.height = 0.075;
+  Simulation full(scene);
+  full.run();
+  scene.integrator.fast_forward = true;
+  Simulation fast(scene);
+  long long jumps_with_a_node_lifted = 0;
+  while (!fast.finished()) {
+    const long long jumps = fast.jumps();
+    fast.advance(scene.stop.time);
+    if (fast.jumps() > jumps && fast.contact().detachedCount() > 0) ++jumps_with_a_node_lifted;
+  }
+  EXPECT_GT(jumps_with_a_node_lifted, 5);
+  EXPECT_LT(fast.steps(), full.steps() / 10);
+  auto extended = [](const std::vector<SlipEvent>& events) {
+    std::vector<SlipEvent> out;
+    for (const SlipEvent& event : events) {
+      if (event.rupture_length > 0.0) out.push_back(event);
+    }
+    return out;
+  };
+  const auto full_events = extended(full.events()), fast_events = extended(fast.events());
+  ASSERT_EQ(fast_events.size(), full_events.size());
+  for (std::size_t e = 0; e < full_events.size(); ++e) {
+    SCOPED_TRACE("event " + std::to_string(e));
+    EXPECT_EQ(fast_events[e].rupture_length, full_events[e].rupture_length);
+    EXPECT_NEAR(fast_events[e].onset_shear_force, full_events[e].onset_shear_force,
+                2e-3 * full_events[e].onset_shear_force);
+  }
+  EXPECT_TRUE(fast_events.back().global);
+  EXPECT_LT(std::abs(fast.energy().relativeResidual()), 5e-4);
+}
+
 TEST(FastForward, StopAndGoAndNormalLoadChangesStayOnTheStaticPath) {
   Scene scene = testing::coarseSliderScene(true);
   scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.01}, StageSegment{StageMode::Hold, 0.0, 0.0, 0.01},

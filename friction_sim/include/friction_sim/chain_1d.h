@@ -35,9 +35,13 @@ class Chain1D : public Model {
   /// is evaluated in one strip.
   void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
                         ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const override;
+  /// normalForces() at the evaluation's F_X.
+  Vector signedNormalForces(const Vector& u, const ForceEvaluation& evaluation) const override;
   double elasticEnergy(const Vector& u, double stage_position) const override;
   double externalWork(const Vector&, const Vector&) const override { return 0.0; }
   SparseMatrix stiffnessMatrix() const override;
+  /// Nothing: a block's normal force is prescribed by the loads, not carried by a contact spring.
+  void releaseContact(SparseMatrix&, int) const override {}
   SparseMatrix dampingMatrix() const override;
   std::vector<int> blockedDofsDuringLoading() const override;
   Vector initialBodyForce() const override;

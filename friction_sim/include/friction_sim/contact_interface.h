@@ -72,8 +72,9 @@ class ContactInterface {
   int slidingCount() const { return sliding_count_; }
   /// True when every node is stuck (none sliding, none detached).
   bool allStuck() const { return sliding_count_ == 0 && detached_count_ == 0; }
-  /// Whether an equilibrium found with the interface pinned keeps every node stuck: each in contact and
-  /// its pin's reaction, −trial.force at its dof, within µ_s·N.
+  int detachedCount() const { return detached_count_; }
+  /// Whether an equilibrium found with the stuck nodes pinned keeps them stuck, each in contact and its
+  /// pin's reaction, −trial.force at its dof, within µ_s·N, and keeps every detached node off the track.
   bool holdsPinned(const ForceEvaluation& trial) const;
   double frictionForce(int node) const { return friction_[latest_slot_][node]; }  ///< N, track on slider, x
   double normalForce(int node) const { return latest_normal_[node]; }             ///< N

@@ -39,9 +39,13 @@ class Lattice2D : public Model {
   /// Strips of whole rows; the external forces on a row are added before it is finished.
   void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
                         ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const override;
+  /// The foundation's force k_f·(−u_z) on each bottom node.
+  Vector signedNormalForces(const Vector& u, const ForceEvaluation& evaluation) const override;
   double elasticEnergy(const Vector& u, double stage_position) const override;
   double externalWork(const Vector& u_from, const Vector& u_to) const override;
   SparseMatrix stiffnessMatrix() const override;
+  /// The foundation's k_f on the node's u_z.
+  void releaseContact(SparseMatrix& stiffness, int node) const override;
   SparseMatrix dampingMatrix() const override;
   bool rebalanceLoad(const Vector& u) override;
   void disconnectPusher() override { pusher_connected_ = false; }

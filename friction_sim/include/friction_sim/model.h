@@ -85,6 +85,9 @@ class Model {
   void evaluate(const Vector& u, const Vector& v, double stage_position, ForceEvaluation& out) const {
     evaluateInto(u, v, stage_position, out.force, out);
   }
+  /// N, every interface node's normal force before contact clamps it at zero: negative while the node
+  /// is off the track. Fast-forward follows it to where a lifted node lands. `evaluation` is that of u.
+  virtual Vector signedNormalForces(const Vector& u, const ForceEvaluation& evaluation) const = 0;
   /// J, energy stored in the springs (lattice, foundation, pusher, top load springs).
   virtual double elasticEnergy(const Vector& u, double stage_position) const = 0;
   /// J, work done by the constant external forces (the uniform top load) between two states.
@@ -92,6 +95,9 @@ class Model {
 
   /// Stiffness matrix linearised about the rest state, including foundation, pusher and top springs.
   virtual SparseMatrix stiffnessMatrix() const = 0;
+  /// Takes out of `stiffness` (the matrix above) the contact stiffness of interface node `node`, for an
+  /// equilibrium in which that node is off the track.
+  virtual void releaseContact(SparseMatrix& stiffness, int node) const = 0;
   /// Damping matrix of the pair damping (force = −C·v).
   virtual SparseMatrix dampingMatrix() const = 0;
 

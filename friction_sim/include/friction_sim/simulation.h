@@ -87,9 +87,10 @@ class Simulation : public Dynamics {
 
  private:
   void relaxToLoadedEquilibrium();
-  /// With the interface pinned where it sticks: the static equilibrium, if it holds every node within
-  /// its threshold and in contact. Applies it (the energy of the ring-down it skips is counted as
-  /// viscous dissipation) and returns true; otherwise leaves the state as it is.
+  /// With the interface pinned where it sticks and free where it has lost contact: the static
+  /// equilibrium, if it holds every stuck node within its threshold and in contact and every lifted node
+  /// off the track. Applies it (the energy of the ring-down it skips is counted as viscous dissipation)
+  /// and returns true; otherwise leaves the state as it is.
   bool relaxToStaticEquilibrium();
   /// The jumps of `advance`; returns false if a dynamic step is needed instead.
   bool fastForward(double until);
@@ -135,7 +136,11 @@ class Simulation : public Dynamics {
   Vector external_reference_u_;         ///< displacements at the last change of F_Z
   double viscous_dissipation_ = 0.0;
   // Fast-forward.
-  std::unique_ptr<StaticSolver> pinned_solver_;  ///< set up once (factor or multigrid), interface pinned, pusher on
+  /// The static solver with the interface nodes in contact pinned, those off the track free, the pusher
+  /// on, set up again (factor or multigrid) only when the set of nodes off the track has changed.
+  StaticSolver& pinnedSolver();
+  std::unique_ptr<StaticSolver> pinned_solver_;  ///< set when fast-forward is on
+  std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
   bool quasi_static_ = false;
   bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
   long long jumps_ = 0;

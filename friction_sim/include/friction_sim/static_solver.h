@@ -28,11 +28,11 @@ constexpr int kDirectSolveDofs = 400000;
 class StaticSolver {
  public:
   /// Factors the stiffness of every degree of freedom not in `fixed_dofs`, as the model is now
-  /// (pusher connected or not). With `balance_load`, a displacement-controlled top load (the spring
-  /// mattress) is re-balanced to carry F_Z while solving, as when the load is applied. Throws
-  /// std::runtime_error if that stiffness is singular.
+  /// (pusher connected or not), without the contact stiffness of the interface nodes in `lifted_nodes`.
+  /// With `balance_load`, a displacement-controlled top load (the spring mattress) is re-balanced to carry
+  /// F_Z while solving, as when the load is applied. Throws std::runtime_error if that stiffness is singular.
   StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load = false,
-               StaticMethod method = StaticMethod::kAuto);
+               StaticMethod method = StaticMethod::kAuto, const std::vector<int>& lifted_nodes = {});
 
   /// Moves the free degrees of freedom of `u` to equilibrium with the stage at `stage_position` (m)
   /// and the extra forces `body_force` (N per dof; empty = none). The fixed ones stay as they are.

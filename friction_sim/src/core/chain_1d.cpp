@@ -67,6 +67,10 @@ std::vector<double> Chain1D::normalForces(double shear_force) const {
   return {w.begin(), w.end()};
 }
 
+Vector Chain1D::signedNormalForces(const Vector&, const ForceEvaluation& evaluation) const {
+  return normalForceExpression(evaluation.shear_force, 0, n_).matrix();
+}
+
 void Chain1D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                            ForceEvaluation& out) const {
   if (top_driving_) {

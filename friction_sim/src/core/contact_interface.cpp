@@ -301,7 +301,11 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
 bool ContactInterface::holdsPinned(const ForceEvaluation& trial) const {
   for (int node = 0; node < size(); ++node) {
     const double normal = trial.normal_force[node];
-    if (normal <= 0.0 || std::abs(trial.force[dofs_[node]]) > static_coefficient_[node] * normal) return false;
+    if (state_[node] == ContactState::Detached) {
+      if (normal > 0.0) return false;
+    } else if (normal <= 0.0 || std::abs(trial.force[dofs_[node]]) > static_coefficient_[node] * normal) {
+      return false;
+    }
   }
   return true;
 }

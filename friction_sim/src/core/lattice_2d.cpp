@@ -237,6 +237,10 @@ void Lattice2D::evaluateInStrips(const Vector& u, const Vector& v, double stage_
   out.shear_force = shear;
 }
 
+Vector Lattice2D::signedNormalForces(const Vector& u, const ForceEvaluation&) const {
+  return -kf_ * u.segment(zDof(nodeIndex(0, 0)), nx_);
+}
+
 double Lattice2D::elasticEnergy(const Vector& u, double stage_position) const {
   const double* ux = u.data();
   const double* uz = u.data() + n_;
@@ -315,6 +319,10 @@ SparseMatrix Lattice2D::stiffnessMatrix() const {
       for (int row : pushed_rows_) add(xDof(nodeIndex(0, row)), xDof(nodeIndex(0, row)), pusher_k_per_row_);
     }
   });
+}
+
+void Lattice2D::releaseContact(SparseMatrix& stiffness, int node) const {
+  stiffness.coeffRef(zDof(nodeIndex(node, 0)), zDof(nodeIndex(node, 0))) -= kf_;
 }
 
 SparseMatrix Lattice2D::dampingMatrix() const {

@@ -48,7 +48,7 @@ void Simulation::relaxToLoadedEquilibrium() {
   if (contact_.updateStates(u_, v_, 0.0, node_mass_)) reapplyFriction();
   initial_elastic_ = model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_);
   if (scene_.integrator.fast_forward) {
-    pinned_solver_ = std::make_unique<StaticSolver>(*model_, contact_.dofs());
+    pinnedSolver();
     quasi_static_ = contact_.slidingCount() == 0;
   }
 }
@@ -60,10 +60,26 @@ void Simulation::refreshAfterStaticChange() {
   if (contact_.updateStates(u_, v_, 0.0, node_mass_)) reapplyFriction();
 }
 
+StaticSolver& Simulation::pinnedSolver() {
+  std::vector<int> lifted, in_contact;
+  for (int node = 0; node < contact_.size(); ++node) {
+    if (contact_.state(node) == ContactState::Detached) {
+      lifted.push_back(node);
+    } else {
+      in_contact.push_back(contact_.dofs()[node]);
+    }
+  }
+  if (!pinned_solver_ || lifted != lifted_nodes_) {
+    pinned_solver_ = std::make_unique<StaticSolver>(*model_, in_contact, false, StaticMethod::kAuto, lifted);
+    lifted_nodes_.swap(lifted);
+  }
+  return *pinned_solver_;
+}
+
 bool Simulation::relaxToStaticEquilibrium() {
-  if (!contact_.allStuck()) return false;
+  if (contact_.slidingCount() > 0) return false;
   Vector relaxed = u_;
-  pinned_solver_->solve(*model_, relaxed, stage_.position());
+  pinnedSolver().solve(*model_, relaxed, stage_.position());
   ForceEvaluation check;
   model_->evaluate(relaxed, Vector::Zero(u_.size()), stage_.position(), check);
   if (!contact_.holdsPinned(check)) return false;
@@ -114,15 +130,29 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
     const Vector at_rest = Vector::Zero(u_.size());
     model_->evaluate(u_, at_rest, stage_.position(), here);
     model_->evaluate(u_, at_rest, stage_.position() + 1.0, moved);
-    along = pinned_solver_->response(moved.force - here.force);
+    along = pinnedSolver().response(moved.force - here.force);
     // Friction needed and normal force of every stuck node are affine in the stage position. Along the
     // path every free node moves at speed·along, and the pair damping's force on the stuck nodes
     // counts towards their thresholds, as it does once the dynamics takes over.
     path_velocity = speed * along;
     const double probe = 1e-6 * model_->nodeSpacing();
     model_->evaluate(u_, path_velocity, stage_.position(), here);
-    model_->evaluate(u_ + probe * along, path_velocity, stage_.position() + probe, moved);
+    const Vector probed = u_ + probe * along;
+    model_->evaluate(probed, path_velocity, stage_.position() + probe, moved);
+    Vector lift, lift_moved;  // signed normal forces of the lifted nodes, which land where they reach 0
+    if (contact_.detachedCount() > 0) {
+      lift = model_->signedNormalForces(u_, here);
+      lift_moved = model_->signedNormalForces(probed, moved);
+    }
     for (int node = 0; node < contact_.size(); ++node) {
+      if (contact_.state(node) == ContactState::Detached) {
+        const double lift_rate = (lift_moved[node] - lift[node]) / probe * speed;
+        if (lift_rate > 0.0 && -lift[node] / lift_rate < jump) {
+          jump = -lift[node] / lift_rate;
+          stops_at_threshold = true;
+        }
+        continue;
+      }
       const int dof = contact_.dofs()[node];
       const double mu = contact_.law().staticCoefficient(node);
       const double force = here.force[dof], force_rate = (moved.force[dof] - force) / probe * speed;
@@ -157,7 +187,7 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   u_ += (stage_end - stage_start) * along;
   stage_.advance(jump);
   time_ += jump;
-  pinned_solver_->solve(*model_, u_, stage_end);
+  pinnedSolver().solve(*model_, u_, stage_end);
   // Along the path the slider moves with the stage: the stage supplies that kinetic energy, as in the
   // dynamics, where it accelerates the slider. Unbooked, it was counted as dissipated at the next relaxation.
   const double kinetic_before = 0.5 * node_mass_ * v_.squaredNorm();
@@ -234,6 +264,7 @@ double Simulation::accelerationInStrips(const Vector& u, const Vector& v, double
 void Simulation::reapplyFriction() { contact_.reapplyFriction(u_, inverse_mass_, a_); }
 
 void Simulation::step() {
+  const int detached_before = contact_.detachedCount();
   contact_.beginStep(u_, v_);
   const double shear_start = evaluation_.shear_force;
   const double stage_start = stage_.position();
@@ -250,7 +281,13 @@ void Simulation::step() {
   event_started_ = !was_in_event && (detector_.inEvent() || event_ended_);
   if (pinned_solver_) {
     if (event_started_) quasi_static_ = approaching_threshold_ = false;
-    if (event_ended_ && relaxToStaticEquilibrium()) quasi_static_ = true;
+    // At rest again when an event ends, or when a node lifts off or lands outside an event: the static
+    // path then goes on with the new set of nodes in contact.
+    const bool contact_changed = contact_.detachedCount() != detached_before && !detector_.inEvent();
+    if ((event_ended_ || contact_changed) && relaxToStaticEquilibrium()) {
+      quasi_static_ = true;
+      approaching_threshold_ = false;
+    }
   }
   checkStop();
 }

@@ -12,9 +12,10 @@ constexpr double kMultigridTolerance = 1e-10;
 /// model's matrix is compacted in place (entries only move towards the front) rather than copied into
 /// a second matrix: a 10⁶-node lattice's stiffness takes 450 MB. Trimming the storage to its new size
 /// still reallocates once. `lower_only` keeps the lower triangle, all the factorisation reads.
-SparseMatrix freeStiffness(const Model& model, const std::vector<int>& position_in_free, int free_count,
-                           bool lower_only) {
+SparseMatrix freeStiffness(const Model& model, const std::vector<int>& lifted_nodes,
+                           const std::vector<int>& position_in_free, int free_count, bool lower_only) {
   SparseMatrix stiffness = model.stiffnessMatrix();
+  for (int node : lifted_nodes) model.releaseContact(stiffness, node);
   stiffness.makeCompressed();
   int* outer = stiffness.outerIndexPtr();
   int* inner = stiffness.innerIndexPtr();
@@ -51,7 +52,7 @@ GridLayout gridLayoutOf(const Model& model) {
 }  // namespace
 
 StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load,
-                           StaticMethod method)
+                           StaticMethod method, const std::vector<int>& lifted_nodes)
     : balance_load_(balance_load) {
   const int n = model.dofCount();
   std::vector<char> fixed(n, 0);
@@ -74,10 +75,10 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
   if (method == StaticMethod::kMultigrid) {
     // Not make_unique: it would pass the matrix on by reference, and Eigen 3.4's sparse matrices,
     // having no move constructor, would be copied (360 MB at 10⁶ nodes).
-    multigrid_.reset(new GridMultigrid(freeStiffness(model, position_in_free, free_count, false), free_dofs_, layout));
+    multigrid_.reset(new GridMultigrid(freeStiffness(model, lifted_nodes, position_in_free, free_count, false), free_dofs_, layout));
     return;
   }
-  const SparseMatrix reduced = freeStiffness(model, position_in_free, free_count, true);
+  const SparseMatrix reduced = freeStiffness(model, lifted_nodes, position_in_free, free_count, true);
   factor_ = std::make_unique<Eigen::CholmodSupernodalLLT<SparseMatrix>>(reduced);
   if (factor_->info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
 }
