@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/simulation.h"
@@ -21,17 +23,100 @@ Simulation& expectSound(Simulation& simulation, double tolerance = 1e-4) {
   return simulation;
 }
 
-TEST(HardCases, TimeStepJustBelowTheLimitRunsAndJustAboveIsRefused) {
+// The hard cases' scenes, shared by their own tests and by the comparison with fast-forward.
+
+/// The coarse slider for 10 ms with dt at `fraction` of its stability limit.
+Scene timeStepAtShareOfLimit(double fraction) {
   Scene scene = testing::coarseSliderScene();
   scene.stop.time = 0.01;
-  const double limit = sceneStabilityLimit(scene);
-  scene.integrator.time_step = 0.9 * limit;
-  Simulation below(scene);
+  scene.integrator.time_step = fraction * sceneStabilityLimit(scene);
+  return scene;
+}
+
+Scene kineticFriction(double kinetic) {
+  Scene scene = testing::coarseSliderScene();
+  scene.friction.kinetic_coefficient = kinetic;
+  scene.stop.time = 0.06;
+  return scene;
+}
+
+Scene undamped() {
+  Scene scene = testing::coarseSliderScene();
+  scene.material.damping_coefficient = 0.0;
+  scene.stop.time = 0.02;
+  return scene;
+}
+
+/// k_f = 100 × the default k/2, dt at 0.9 of the (smaller) stability limit.
+Scene stiffFoundation() {
+  Scene scene = testing::coarseSliderScene();
+  scene.lattice.foundation_ratio = 50.0;
+  scene.integrator.time_step = 0.9 * sceneStabilityLimit(scene);
+  scene.stop.time = 0.02;
+  return scene;
+}
+
+Scene pushedAt(double height) {
+  Scene scene = testing::coarseSliderScene();
+  scene.pusher.height = height;
+  return scene;
+}
+
+/// 100 N pressed, pushed at the top: the moment lifts the trailing edge.
+Scene liftingEdge() {
+  Scene scene = pushedAt(0.075);
+  scene.load.normal_force = 100.0;
+  scene.stop.global_events = 2;
+  return scene;
+}
+
+Scene twoBlockChain() {
+  Scene scene = loadScene(testing::scenePath("pmma_1d_side"));
+  scene.chain.blocks = 2;
+  scene.integrator.time_step = 0.05 * sceneStabilityLimit(scene);
+  scene.stop.global_events = 3;
+  return scene;
+}
+
+Scene fourNodeLattice() {
+  Scene scene = testing::coarseSliderScene();
+  scene.lattice.nodes_x = 2;
+  scene.lattice.nodes_z = 2;
+  scene.geometry.length = scene.geometry.height = 0.075;
+  scene.integrator.time_step = 0.05 * sceneStabilityLimit(scene);
+  scene.stop.global_events = 2;
+  return scene;
+}
+
+Scene racingStage() {
+  Scene scene = testing::coarseSliderScene();
+  scene.stage.max_speed = 20.0;
+  scene.stage.program = {StageSegment{StageMode::Velocity, 10.0}};
+  scene.stop.time = 2e-4;
+  return scene;
+}
+
+/// 50 µm in 50 ns.
+Scene jumpingStage() {
+  Scene scene = testing::coarseSliderScene();
+  scene.stage.max_speed = 1e3;
+  scene.stage.program = {StageSegment{StageMode::Position, 1e3, 5e-5}};
+  scene.stop.time = 5e-3;
+  return scene;
+}
+
+Scene hundredCycles() {
+  Scene scene = testing::singleBlockScene(IntegratorKind::VelocityVerlet, 0.8, 1e-8);
+  scene.stop.global_events = 100;
+  return scene;
+}
+
+TEST(HardCases, TimeStepJustBelowTheLimitRunsAndJustAboveIsRefused) {
+  Simulation below(timeStepAtShareOfLimit(0.9));
   expectSound(below);
   EXPECT_LT(below.velocities().lpNorm<Eigen::Infinity>(), 1.0);  // no blow-up
-  scene.integrator.time_step = 1.1 * limit;
   try {
-    Simulation above(scene);
+    Simulation above(timeStepAtShareOfLimit(1.1));
     FAIL() << "accepted";
   } catch (const SceneError& error) {
     EXPECT_NE(std::string(error.what()).find("stability limit"), std::string::npos);
@@ -41,10 +126,7 @@ TEST(HardCases, TimeStepJustBelowTheLimitRunsAndJustAboveIsRefused) {
 TEST(HardCases, EqualStaticAndKineticFrictionAndZeroKineticFriction) {
   for (double kinetic : {0.4, 0.0}) {
     SCOPED_TRACE("mu_k = " + std::to_string(kinetic));
-    Scene scene = testing::coarseSliderScene();
-    scene.friction.kinetic_coefficient = kinetic;
-    scene.stop.time = 0.06;
-    Simulation simulation(scene);
+    Simulation simulation(kineticFriction(kinetic));
     expectSound(simulation);
     // With µ_k = µ_s the trailing edge creeps steadily instead of slipping in events; either way the
     // interface has slipped by now.
@@ -53,15 +135,9 @@ TEST(HardCases, EqualStaticAndKineticFrictionAndZeroKineticFriction) {
 }
 
 TEST(HardCases, NoDampingAndAStiffFoundation) {
-  Scene undamped = testing::coarseSliderScene();
-  undamped.material.damping_coefficient = 0.0;
-  undamped.stop.time = 0.02;
-  Simulation first(undamped);
+  Simulation first(undamped());
   expectSound(first, 1e-3);  // undamped ringing: the quadrature error is not damped away
-  Scene stiff = testing::coarseSliderScene();
-  stiff.lattice.foundation_ratio = 50.0;  // k_f = 100 × the default k/2
-  stiff.integrator.time_step = 0.9 * sceneStabilityLimit(stiff);
-  stiff.stop.time = 0.02;
+  const Scene stiff = stiffFoundation();
   EXPECT_LT(stiff.integrator.time_step, 0.9 * sceneStabilityLimit(testing::coarseSliderScene()));
   Simulation second(stiff);
   expectSound(second);
@@ -70,21 +146,14 @@ TEST(HardCases, NoDampingAndAStiffFoundation) {
 TEST(HardCases, PusherAtTheBottomCornerAndAtTheTop) {
   for (double height : {0.0, 0.075}) {
     SCOPED_TRACE("h = " + std::to_string(height));
-    Scene scene = testing::coarseSliderScene();
-    scene.pusher.height = height;
-    Simulation simulation(scene);
+    Simulation simulation(pushedAt(height));
     expectSound(simulation);
     EXPECT_EQ(simulation.globalEventCount(), 1);
   }
 }
 
 TEST(HardCases, EdgeLiftsOffAndComesBack) {
-  // 100 N pressed, pushed at the top: the moment lifts the trailing edge.
-  Scene scene = testing::coarseSliderScene();
-  scene.load.normal_force = 100.0;
-  scene.pusher.height = 0.075;
-  scene.stop.global_events = 2;
-  Simulation simulation(scene);
+  Simulation simulation(liftingEdge());
   std::vector<char> lifted(simulation.contact().size(), 0);
   int lift_offs = 0, recontacts = 0;
   while (!simulation.finished()) {
@@ -102,46 +171,26 @@ TEST(HardCases, EdgeLiftsOffAndComesBack) {
 }
 
 TEST(HardCases, SmallestSystems) {
-  Scene chain = loadScene(testing::scenePath("pmma_1d_side"));
-  chain.chain.blocks = 2;
-  chain.integrator.time_step = 0.05 * sceneStabilityLimit(chain);
-  chain.stop.global_events = 3;
-  Simulation two_blocks(chain);
+  Simulation two_blocks(twoBlockChain());
   expectSound(two_blocks, 1e-4);
   EXPECT_EQ(two_blocks.globalEventCount(), 3);
-  Scene lattice = testing::coarseSliderScene();
-  lattice.lattice.nodes_x = 2;
-  lattice.lattice.nodes_z = 2;
-  lattice.geometry.length = lattice.geometry.height = 0.075;
-  lattice.integrator.time_step = 0.05 * sceneStabilityLimit(lattice);
-  lattice.stop.global_events = 2;
-  Simulation four_nodes(lattice);
+  Simulation four_nodes(fourNodeLattice());
   expectSound(four_nodes, 1e-4);
   EXPECT_EQ(four_nodes.globalEventCount(), 2);
 }
 
 TEST(HardCases, FastStageAndSuddenStageJump) {
-  Scene fast = testing::coarseSliderScene();
-  fast.stage.max_speed = 20.0;
-  fast.stage.program = {StageSegment{StageMode::Velocity, 10.0}};
-  fast.stop.time = 2e-4;
-  Simulation racing(fast);
+  Simulation racing(racingStage());
   // The stage moves 4 µm per step: the trapezoid rule for the pusher's work is then good to ~1e-3.
   expectSound(racing, 5e-3);
-  Scene jump = testing::coarseSliderScene();
-  jump.stage.max_speed = 1e3;
-  jump.stage.program = {StageSegment{StageMode::Position, 1e3, 5e-5}};  // 50 µm in 50 ns
-  jump.stop.time = 5e-3;
-  Simulation jumping(jump);
+  Simulation jumping(jumpingStage());
   // 200 N of pusher force appear within one step; the work trapezoid is good to a few 1e-3 then.
   expectSound(jumping, 5e-3);
   EXPECT_DOUBLE_EQ(jumping.stage().position(), 5e-5);
 }
 
 TEST(HardCases, HundredStickSlipCyclesWithoutDrift) {
-  Scene scene = testing::singleBlockScene(IntegratorKind::VelocityVerlet, 0.8, 1e-8);
-  scene.stop.global_events = 100;
-  Simulation simulation(scene);
+  Simulation simulation(hundredCycles());
   simulation.run();
   const auto& events = simulation.events();
   ASSERT_EQ(events.size(), 100u);
@@ -152,6 +201,62 @@ TEST(HardCases, HundredStickSlipCyclesWithoutDrift) {
   const double period_last = events[99].onset_time - events[98].onset_time;
   EXPECT_NEAR(period_last, period_first, 1e-6 * period_first);
   EXPECT_LT(std::abs(simulation.energy().relativeResidual()), 1e-6);
+}
+
+/// A hard case run both in full dynamics and with fast-forward.
+struct FastForwardCase {
+  std::string name;
+  Scene scene;
+  double onset_tolerance;   ///< relative, on every global event's onset force
+  double end_tolerance;     ///< relative, on the final pusher force of a run without a global event
+  double energy_tolerance;  ///< relative energy-budget residual allowed in either run
+};
+
+TEST(HardCases, FastForwardAgreesWithFullDynamics) {
+  // The same global events in both, their onset forces within the tolerance; a run without a global
+  // event ends with the same pusher force. Tolerances about 3× the deviation measured (in brackets).
+  // After µ_k = 0's global slip the frictionless slider oscillates: only its onset is compared.
+  const std::vector<FastForwardCase> cases = {
+      {"dt at 0.9 x the limit", timeStepAtShareOfLimit(0.9), 0.0, 6e-4, 1e-4},  // end 1.9e-4
+      {"mu_k = mu_s", kineticFriction(0.4), 0.0, 2e-5, 1e-4},                   // end 4.5e-6
+      {"mu_k = 0", kineticFriction(0.0), 2e-4, 0.0, 2e-4},                      // onset 4.6e-5
+      {"no damping", undamped(), 0.0, 2e-3, 1e-3},                              // end 5.1e-4
+      {"stiff foundation", stiffFoundation(), 0.0, 3e-4, 1e-4},                 // end 8.0e-5
+      {"pusher at h = 0", pushedAt(0.0), 5e-4, 0.0, 1e-4},                      // onset 1.3e-4
+      {"pusher at the top", pushedAt(0.075), 6e-4, 0.0, 5e-4},                  // onset 1.9e-4
+      // The landings of the lifted corner differ most: fast-forward skips the ring-downs that decide them.
+      {"edge lifts off, 100 N", liftingEdge(), 3e-2, 0.0, 1e-4},                // onsets 1.1e-2, 1.0e-2
+      {"2-block chain", twoBlockChain(), 2e-5, 0.0, 1e-4},                      // onsets 5.4e-6
+      {"2 x 2 lattice", fourNodeLattice(), 2e-4, 0.0, 2e-4},                    // onsets 4.9e-5
+      {"10 m/s stage", racingStage(), 0.0, 1e-12, 5e-3},                        // the same run
+      {"stage jump", jumpingStage(), 0.0, 3e-5, 5e-3},                          // end 6.8e-6
+      {"100 stick-slip cycles", hundredCycles(), 1e-12, 0.0, 1e-6},             // the same onsets
+  };
+  for (const FastForwardCase& entry : cases) {
+    SCOPED_TRACE(entry.name);
+    Scene scene = entry.scene;
+    scene.integrator.fast_forward = false;
+    Simulation full(scene);
+    expectSound(full, entry.energy_tolerance);
+    scene.integrator.fast_forward = true;
+    Simulation fast(scene);
+    expectSound(fast, entry.energy_tolerance);
+    ASSERT_EQ(fast.globalEventCount(), full.globalEventCount());
+    std::vector<double> full_onsets, fast_onsets;
+    for (const SlipEvent& event : full.events()) {
+      if (event.global) full_onsets.push_back(event.onset_shear_force);
+    }
+    for (const SlipEvent& event : fast.events()) {
+      if (event.global) fast_onsets.push_back(event.onset_shear_force);
+    }
+    for (std::size_t e = 0; e < full_onsets.size(); ++e) {
+      EXPECT_NEAR(fast_onsets[e], full_onsets[e], entry.onset_tolerance * full_onsets[e]) << "global event " << e;
+    }
+    if (full_onsets.empty()) {
+      const double end = full.loadCells().shear_force;
+      EXPECT_NEAR(fast.loadCells().shear_force, end, entry.end_tolerance * std::abs(end));
+    }
+  }
 }
 
 TEST(HardCases, UnresolvedWeakeningLengthIsWarned) {

@@ -4,6 +4,7 @@
 // and keeping the energy budget. No ROS here: the offline runner and the ROS node both drive this.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -38,7 +39,7 @@ class Simulation : public Dynamics {
   /// True while the slider sits in static equilibrium with every node stuck (fast-forward can jump).
   bool quasiStatic() const { return quasi_static_; }
   /// True if the next `advance` may be a fast-forward jump.
-  bool mayJump() const { return quasi_static_ && !approaching_threshold_; }
+  bool mayJump() const { return quasi_static_ && !approaching_threshold_ && !stageTooFast(); }
   /// Fast-forward jumps taken, and simulated time (s) they covered.
   long long jumps() const { return jumps_; }
   double jumpedTime() const { return jumped_time_; }
@@ -102,6 +103,8 @@ class Simulation : public Dynamics {
   static constexpr double kApproachShare = 0.9;
   /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about five).
   static constexpr int kMaxApproachJumps = 50;
+  /// True while the stage moves too fast for the slider to follow it through static equilibria.
+  bool stageTooFast() const { return std::abs(stage_.velocity()) > quasi_static_stage_speed_; }
   void refreshAfterStaticChange();
   void reapplyFriction();
   /// Sets the stop reason once a stop condition holds. Called every step.
@@ -143,6 +146,9 @@ class Simulation : public Dynamics {
   std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
   bool quasi_static_ = false;
   bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
+  /// m/s, 10⁻³ of the bar-wave speed √(E/ρ): MODEL.md §5's fast-forward rests on a stage far slower than
+  /// the waves (the lab's is 10⁻⁸ of it). A stage step that moves faster leaves the static path.
+  double quasi_static_stage_speed_;
   long long jumps_ = 0;
   double jumped_time_ = 0.0;
 };

@@ -23,7 +23,8 @@ Simulation::Simulation(const Scene& scene, double stability_limit)
       dt_(scene_.integrator.time_step),
       stability_limit_(stability_limit),
       node_mass_(model_->nodeMass()),
-      inverse_mass_(1.0 / node_mass_) {
+      inverse_mass_(1.0 / node_mass_),
+      quasi_static_stage_speed_(1e-3 * std::sqrt(scene_.material.youngs_modulus / scene_.material.density)) {
   relaxToLoadedEquilibrium();
 }
 
@@ -265,6 +266,7 @@ void Simulation::reapplyFriction() { contact_.reapplyFriction(u_, inverse_mass_,
 
 void Simulation::step() {
   const int detached_before = contact_.detachedCount();
+  const bool stage_too_fast = stageTooFast();
   contact_.beginStep(u_, v_);
   const double shear_start = evaluation_.shear_force;
   const double stage_start = stage_.position();
@@ -280,11 +282,11 @@ void Simulation::step() {
                                  {shear_start, evaluation_.shear_force, evaluation_.normal_load});
   event_started_ = !was_in_event && (detector_.inEvent() || event_ended_);
   if (pinned_solver_) {
-    if (event_started_) quasi_static_ = approaching_threshold_ = false;
+    if (event_started_ || stage_too_fast) quasi_static_ = approaching_threshold_ = false;
     // At rest again when an event ends, or when a node lifts off or lands outside an event: the static
     // path then goes on with the new set of nodes in contact.
     const bool contact_changed = contact_.detachedCount() != detached_before && !detector_.inEvent();
-    if ((event_ended_ || contact_changed) && relaxToStaticEquilibrium()) {
+    if ((event_ended_ || contact_changed) && !stage_too_fast && relaxToStaticEquilibrium()) {
       quasi_static_ = true;
       approaching_threshold_ = false;
     }
