@@ -203,6 +203,14 @@ TEST(HardCases, HundredStickSlipCyclesWithoutDrift) {
   EXPECT_LT(std::abs(simulation.energy().relativeResidual()), 1e-6);
 }
 
+std::vector<double> globalOnsets(const Simulation& simulation) {
+  std::vector<double> onsets;
+  for (const SlipEvent& event : simulation.events()) {
+    if (event.global) onsets.push_back(event.onset_shear_force);
+  }
+  return onsets;
+}
+
 /// A hard case run both in full dynamics and with fast-forward.
 struct FastForwardCase {
   std::string name;
@@ -210,11 +218,13 @@ struct FastForwardCase {
   double onset_tolerance;   ///< relative, on every global event's onset force
   double end_tolerance;     ///< relative, on the final pusher force of a run without a global event
   double energy_tolerance;  ///< relative energy-budget residual allowed in either run
+  bool jumps = true;        ///< whether fast-forward jumps at all (not while the stage moves fast)
 };
 
 TEST(HardCases, FastForwardAgreesWithFullDynamics) {
   // The same global events in both, their onset forces within the tolerance; a run without a global
-  // event ends with the same pusher force. Tolerances about 3× the deviation measured (in brackets).
+  // event ends with the same pusher force. Tolerances about 3× the deviation measured (in comments).
+  // The large lattice (a few steps), the refused time step and the warning have no run to compare.
   // After µ_k = 0's global slip the frictionless slider oscillates: only its onset is compared.
   const std::vector<FastForwardCase> cases = {
       {"dt at 0.9 x the limit", timeStepAtShareOfLimit(0.9), 0.0, 6e-4, 1e-4},  // end 1.9e-4
@@ -228,7 +238,7 @@ TEST(HardCases, FastForwardAgreesWithFullDynamics) {
       {"edge lifts off, 100 N", liftingEdge(), 3e-2, 0.0, 1e-4},                // onsets 1.1e-2, 1.0e-2
       {"2-block chain", twoBlockChain(), 2e-5, 0.0, 1e-4},                      // onsets 5.4e-6
       {"2 x 2 lattice", fourNodeLattice(), 2e-4, 0.0, 2e-4},                    // onsets 4.9e-5
-      {"10 m/s stage", racingStage(), 0.0, 1e-12, 5e-3},                        // the same run
+      {"10 m/s stage", racingStage(), 0.0, 1e-12, 5e-3, false},                 // the same run
       {"stage jump", jumpingStage(), 0.0, 3e-5, 5e-3},                          // end 6.8e-6
       {"100 stick-slip cycles", hundredCycles(), 1e-12, 0.0, 1e-6},             // the same onsets
   };
@@ -241,14 +251,10 @@ TEST(HardCases, FastForwardAgreesWithFullDynamics) {
     scene.integrator.fast_forward = true;
     Simulation fast(scene);
     expectSound(fast, entry.energy_tolerance);
-    ASSERT_EQ(fast.globalEventCount(), full.globalEventCount());
-    std::vector<double> full_onsets, fast_onsets;
-    for (const SlipEvent& event : full.events()) {
-      if (event.global) full_onsets.push_back(event.onset_shear_force);
-    }
-    for (const SlipEvent& event : fast.events()) {
-      if (event.global) fast_onsets.push_back(event.onset_shear_force);
-    }
+    EXPECT_EQ(fast.jumps() > 0, entry.jumps);
+    const std::vector<double> full_onsets = globalOnsets(full), fast_onsets = globalOnsets(fast);
+    EXPECT_EQ(fast_onsets.size(), full_onsets.size());
+    if (fast_onsets.size() != full_onsets.size()) continue;
     for (std::size_t e = 0; e < full_onsets.size(); ++e) {
       EXPECT_NEAR(fast_onsets[e], full_onsets[e], entry.onset_tolerance * full_onsets[e]) << "global event " << e;
     }

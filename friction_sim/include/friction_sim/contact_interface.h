@@ -73,6 +73,8 @@ class ContactInterface {
   /// True when every node is stuck (none sliding, none detached).
   bool allStuck() const { return sliding_count_ == 0 && detached_count_ == 0; }
   int detachedCount() const { return detached_count_; }
+  /// Lift-offs and landings so far (a count that only grows: a lift-off and a landing in one step both count).
+  long long contactChanges() const { return contact_changes_; }
   /// Whether an equilibrium found with the stuck nodes pinned keeps them stuck, each in contact and its
   /// pin's reaction, −trial.force at its dof, within µ_s·N, and keeps every detached node off the track.
   bool holdsPinned(const ForceEvaluation& trial) const;
@@ -125,6 +127,7 @@ class ContactInterface {
   double k_t_;
   std::vector<ContactState> state_;
   int sliding_count_ = 0, detached_count_ = 0;
+  long long contact_changes_ = 0;
   // Per node, in the form the friction loop needs: its mode, 2 if stuck, the sliding direction
   // ±1 if sliding, 0 if detached (one array rather than a stuck weight and a sign: the loop is bound by
   // memory traffic); the law's µ_s and current sliding µ.

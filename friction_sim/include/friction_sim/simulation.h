@@ -30,13 +30,14 @@ class Simulation : public Dynamics {
 
   /// Advances by one time step.
   void step();
-  /// Advances by one time step or, with fast-forward on while the interface sits stuck in static
-  /// equilibrium, jumps along the equilibrium to the earliest of `until` (s), the stage's next change
-  /// and just before the next node reaches its threshold (MODEL.md §5).
+  /// Advances by one time step or, with fast-forward on while the interface sits in static equilibrium
+  /// with no node sliding and the stage moves slowly, jumps along the equilibrium to the earliest of
+  /// `until` (s), the stage's next change and just before the next node reaches its threshold, loses
+  /// contact or, lifted, lands (MODEL.md §5).
   void advance(double until);
   /// Advances until the scene's stop condition holds.
   void run();
-  /// True while the slider sits in static equilibrium with every node stuck (fast-forward can jump).
+  /// True while the slider sits in static equilibrium with no node sliding (fast-forward can jump).
   bool quasiStatic() const { return quasi_static_; }
   /// True if the next `advance` may be a fast-forward jump.
   bool mayJump() const { return quasi_static_ && !approaching_threshold_ && !stageTooFast(); }
@@ -103,6 +104,10 @@ class Simulation : public Dynamics {
   static constexpr double kApproachShare = 0.9;
   /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about five).
   static constexpr int kMaxApproachJumps = 50;
+  /// The static solver with the interface nodes in contact pinned, those off the track free, the pusher
+  /// on, set up again (factor or multigrid) only when the set of nodes off the track has changed. Null
+  /// if that set leaves the slider free to move (every node lifted, say): then the dynamics go on.
+  StaticSolver* pinnedSolver();
   /// True while the stage moves too fast for the slider to follow it through static equilibria.
   bool stageTooFast() const { return std::abs(stage_.velocity()) > quasi_static_stage_speed_; }
   void refreshAfterStaticChange();
@@ -139,10 +144,7 @@ class Simulation : public Dynamics {
   Vector external_reference_u_;         ///< displacements at the last change of F_Z
   double viscous_dissipation_ = 0.0;
   // Fast-forward.
-  /// The static solver with the interface nodes in contact pinned, those off the track free, the pusher
-  /// on, set up again (factor or multigrid) only when the set of nodes off the track has changed.
-  StaticSolver& pinnedSolver();
-  std::unique_ptr<StaticSolver> pinned_solver_;  ///< set when fast-forward is on
+  std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
   std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
   bool quasi_static_ = false;
   bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically

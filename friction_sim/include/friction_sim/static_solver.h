@@ -34,9 +34,12 @@ class StaticSolver {
   StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load = false,
                StaticMethod method = StaticMethod::kAuto, const std::vector<int>& lifted_nodes = {});
 
+  /// Modified-Newton iterations after which solve() gives up.
+  static constexpr int kMaxIterations = 500;
+
   /// Moves the free degrees of freedom of `u` to equilibrium with the stage at `stage_position` (m)
   /// and the extra forces `body_force` (N per dof; empty = none). The fixed ones stay as they are.
-  /// Returns the number of iterations.
+  /// Returns the number of iterations, kMaxIterations + 1 if it did not converge.
   int solve(Model& model, Vector& u, double stage_position, const Vector& body_force = Vector()) const;
 
   /// Displacement of the free degrees of freedom per unit of a force vector on them (K_ff⁻¹·f).

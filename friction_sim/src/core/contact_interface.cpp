@@ -42,7 +42,9 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
 
 void ContactInterface::setState(int node, ContactState state) {
   sliding_count_ += (state == ContactState::Sliding) - (state_[node] == ContactState::Sliding);
-  detached_count_ += (state == ContactState::Detached) - (state_[node] == ContactState::Detached);
+  const int lifts = (state == ContactState::Detached) - (state_[node] == ContactState::Detached);
+  detached_count_ += lifts;
+  contact_changes_ += lifts != 0;
   state_[node] = state;
   friction_mode_[node] = state == ContactState::Stuck ? kStuckMode : 0.0;  // startSliding sets the direction
 }

@@ -49,8 +49,7 @@ void Simulation::relaxToLoadedEquilibrium() {
   if (contact_.updateStates(u_, v_, 0.0, node_mass_)) reapplyFriction();
   initial_elastic_ = model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_);
   if (scene_.integrator.fast_forward) {
-    pinnedSolver();
-    quasi_static_ = contact_.slidingCount() == 0;
+    quasi_static_ = contact_.slidingCount() == 0 && pinnedSolver() != nullptr;
   }
 }
 
@@ -61,7 +60,7 @@ void Simulation::refreshAfterStaticChange() {
   if (contact_.updateStates(u_, v_, 0.0, node_mass_)) reapplyFriction();
 }
 
-StaticSolver& Simulation::pinnedSolver() {
+StaticSolver* Simulation::pinnedSolver() {
   std::vector<int> lifted, in_contact;
   for (int node = 0; node < contact_.size(); ++node) {
     if (contact_.state(node) == ContactState::Detached) {
@@ -70,17 +69,25 @@ StaticSolver& Simulation::pinnedSolver() {
       in_contact.push_back(contact_.dofs()[node]);
     }
   }
-  if (!pinned_solver_ || lifted != lifted_nodes_) {
-    pinned_solver_ = std::make_unique<StaticSolver>(*model_, in_contact, false, StaticMethod::kAuto, lifted);
+  if (lifted != lifted_nodes_ || (lifted_nodes_.empty() && !pinned_solver_)) {
+    pinned_solver_.reset();  // first: at 10⁶ nodes two solvers would not fit the memory budget
     lifted_nodes_.swap(lifted);
+    try {
+      pinned_solver_ = std::make_unique<StaticSolver>(*model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
+    } catch (const std::runtime_error&) {
+      // Singular: too few nodes in contact hold the slider.
+    }
   }
-  return *pinned_solver_;
+  return pinned_solver_.get();
 }
 
 bool Simulation::relaxToStaticEquilibrium() {
   if (contact_.slidingCount() > 0) return false;
+  StaticSolver* solver = pinnedSolver();
+  if (!solver) return false;
   Vector relaxed = u_;
-  pinnedSolver().solve(*model_, relaxed, stage_.position());
+  // A lifted node that wants its contact back leaves modified Newton without a converged answer.
+  if (solver->solve(*model_, relaxed, stage_.position()) > StaticSolver::kMaxIterations) return false;
   ForceEvaluation check;
   model_->evaluate(relaxed, Vector::Zero(u_.size()), stage_.position(), check);
   if (!contact_.holdsPinned(check)) return false;
@@ -92,6 +99,7 @@ bool Simulation::relaxToStaticEquilibrium() {
   u_ = relaxed;
   v_.setZero();
   refreshAfterStaticChange();
+  approaching_threshold_ = false;
   return true;
 }
 
@@ -120,7 +128,8 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   const double span = std::min(horizon, stage_.timeToNextChange());
   const double speed = stage_.velocity();
   toward_threshold = false;
-  if (!(span > dt_)) return false;
+  StaticSolver* solver = pinnedSolver();
+  if (!(span > dt_) || !solver) return false;
   double jump = span;
   Vector along = Vector::Zero(u_.size());  // du/dX_s along the equilibrium
   Vector path_velocity = Vector::Zero(u_.size());  // m/s, every free node moves with the stage
@@ -131,7 +140,7 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
     const Vector at_rest = Vector::Zero(u_.size());
     model_->evaluate(u_, at_rest, stage_.position(), here);
     model_->evaluate(u_, at_rest, stage_.position() + 1.0, moved);
-    along = pinnedSolver().response(moved.force - here.force);
+    along = solver->response(moved.force - here.force);
     // Friction needed and normal force of every stuck node are affine in the stage position. Along the
     // path every free node moves at speed·along, and the pair damping's force on the stuck nodes
     // counts towards their thresholds, as it does once the dynamics takes over.
@@ -188,12 +197,20 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   u_ += (stage_end - stage_start) * along;
   stage_.advance(jump);
   time_ += jump;
-  pinnedSolver().solve(*model_, u_, stage_end);
-  // Along the path the slider moves with the stage: the stage supplies that kinetic energy, as in the
-  // dynamics, where it accelerates the slider. Unbooked, it was counted as dissipated at the next relaxation.
   const double kinetic_before = 0.5 * node_mass_ * v_.squaredNorm();
+  solver->solve(*model_, u_, stage_end);
   v_.swap(path_velocity);
-  pusher_work_ += 0.5 * node_mass_ * v_.squaredNorm() - kinetic_before;
+  // Along the path every node moves with the stage: the stage supplies that kinetic energy, as in the
+  // dynamics, where it accelerates the slider (otherwise the next relaxation would count it as
+  // dissipated); kinetic energy lost when the stage stops rings down in the dynamics.
+  const double kinetic_change = 0.5 * node_mass_ * v_.squaredNorm() - kinetic_before;
+  if (kinetic_change > 0.0) {
+    pusher_work_ += kinetic_change;
+  } else {
+    viscous_dissipation_ -= kinetic_change;
+  }
+  // The jump is a step of its own for the slip of an event that starts at its end (a lifted node moved).
+  contact_.beginStep(u_, v_);
   refreshAfterStaticChange();
   // Round-off may land a node just past its threshold: then its slip starts here.
   detector_.update(time_, 0.0, contact_, u_, {evaluation_.shear_force, evaluation_.shear_force, evaluation_.normal_load});
@@ -265,7 +282,8 @@ double Simulation::accelerationInStrips(const Vector& u, const Vector& v, double
 void Simulation::reapplyFriction() { contact_.reapplyFriction(u_, inverse_mass_, a_); }
 
 void Simulation::step() {
-  const int detached_before = contact_.detachedCount();
+  const long long contact_changes_before = contact_.contactChanges();
+  const bool was_quasi_static = quasi_static_;
   const bool stage_too_fast = stageTooFast();
   contact_.beginStep(u_, v_);
   const double shear_start = evaluation_.shear_force;
@@ -281,15 +299,14 @@ void Simulation::step() {
   event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_,
                                  {shear_start, evaluation_.shear_force, evaluation_.normal_load});
   event_started_ = !was_in_event && (detector_.inEvent() || event_ended_);
-  if (pinned_solver_) {
+  if (scene_.integrator.fast_forward) {
     if (event_started_ || stage_too_fast) quasi_static_ = approaching_threshold_ = false;
-    // At rest again when an event ends, or when a node lifts off or lands outside an event: the static
-    // path then goes on with the new set of nodes in contact.
-    const bool contact_changed = contact_.detachedCount() != detached_before && !detector_.inEvent();
-    if ((event_ended_ || contact_changed) && !stage_too_fast && relaxToStaticEquilibrium()) {
-      quasi_static_ = true;
-      approaching_threshold_ = false;
-    }
+    // Back on the static path when an event ends, or when a node lifts off or lands in a step taken on
+    // the path (the path goes on with the new set of nodes in contact). Not while the slider rings
+    // after a fast stage move: only the end of an event brings it back then.
+    const bool contact_changed = was_quasi_static && contact_.contactChanges() != contact_changes_before &&
+                                 !detector_.inEvent();
+    if ((event_ended_ || contact_changed) && !stage_too_fast && relaxToStaticEquilibrium()) quasi_static_ = true;
   }
   checkStop();
 }
@@ -327,7 +344,9 @@ std::string Simulation::setNormalLoad(double normal_force) {
   external_reference_u_ = u_;
   model_->setNormalLoad(normal_force);
   power_ = acceleration(u_, v_, time_, a_);
-  if (pinned_solver_) quasi_static_ = !detector_.inEvent() && relaxToStaticEquilibrium();
+  if (scene_.integrator.fast_forward) {
+    quasi_static_ = !detector_.inEvent() && !stageTooFast() && relaxToStaticEquilibrium();
+  }
   return {};
 }
 

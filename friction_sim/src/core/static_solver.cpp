@@ -103,7 +103,7 @@ int StaticSolver::solve(Model& model, Vector& u, double stage_position, const Ve
   if (free_dofs_.empty()) return 0;
   ForceEvaluation evaluation;
   const Vector at_rest = Vector::Zero(u.size());
-  for (int iteration = 1; iteration <= 500; ++iteration) {
+  for (int iteration = 1; iteration <= kMaxIterations; ++iteration) {
     model.evaluate(u, at_rest, stage_position, evaluation);
     if (body_force.size() > 0) evaluation.force += body_force;
     const Vector correction = response(evaluation.force);
@@ -111,7 +111,7 @@ int StaticSolver::solve(Model& model, Vector& u, double stage_position, const Ve
     const bool load_changed = balance_load_ && model.rebalanceLoad(u);
     if (!load_changed && correction.lpNorm<Eigen::Infinity>() < tolerance_) return iteration;
   }
-  return 500;
+  return kMaxIterations + 1;
 }
 
 }  // namespace friction
