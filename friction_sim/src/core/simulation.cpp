@@ -61,17 +61,17 @@ void Simulation::refreshAfterStaticChange() {
 }
 
 StaticSolver* Simulation::pinnedSolver() {
-  std::vector<int> lifted, in_contact;
+  std::vector<int> lifted;
   for (int node = 0; node < contact_.size(); ++node) {
-    if (contact_.state(node) == ContactState::Detached) {
-      lifted.push_back(node);
-    } else {
-      in_contact.push_back(contact_.dofs()[node]);
-    }
+    if (contact_.state(node) == ContactState::Detached) lifted.push_back(node);
   }
   if (lifted != lifted_nodes_ || (lifted_nodes_.empty() && !pinned_solver_)) {
     pinned_solver_.reset();  // first: at 10⁶ nodes two solvers would not fit the memory budget
     lifted_nodes_.swap(lifted);
+    std::vector<int> in_contact;
+    for (int node = 0; node < contact_.size(); ++node) {
+      if (contact_.state(node) != ContactState::Detached) in_contact.push_back(contact_.dofs()[node]);
+    }
     try {
       pinned_solver_ = std::make_unique<StaticSolver>(*model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
     } catch (const std::runtime_error&) {
