@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# Runs the same twelve scenes with two builds of friction_run and says whether their results are
+# Runs the same thirteen scenes with two builds of friction_run and says whether their results are
 # byte-identical: the check behind "results unchanged" for a change meant to be speed only.
 #
 #   scripts/compare_outputs.sh REFERENCE_RUNNER CANDIDATE_RUNNER [WORK_DIR]
 #
 # The scenes cover the 1D chain (side- and top-driven, tilted) and the 2D lattice (geometric and linear
-# springs), Amontons–Coulomb and slip weakening, velocity Verlet and RK4, fast-forward on and off.
+# springs; one lattice wider than the force sweep's column chunks), Amontons–Coulomb and slip weakening, velocity Verlet and RK4, fast-forward on and off.
 # Every results file is compared except the summary's wall-time line. Exit status 0 if all are identical,
-# 1 if any differ (the differing files are listed), 2 on a usage error. About 40 s (24 runs).
+# 1 if any differ (the differing files are listed), 2 on a usage error. About 45 s (26 runs).
 set -euo pipefail
 
 if [[ $# -lt 2 || $# -gt 3 ]]; then
@@ -27,6 +27,7 @@ cases=(
   "2d_sw|pmma_2d.yaml|friction.law=slip_weakening"
   "2d_rk4|pmma_2d.yaml|integrator.scheme=rk4"
   "2d_mattress|pmma_2d.yaml|load.top=spring_mattress"
+  "2d_wide|pmma_2d.yaml|lattice.nodes_x=281 lattice.nodes_z=16 geometry.height=0.0075 integrator.time_step=4e-8 stop.time=0.2"
   "1d_side|pmma_1d_side.yaml|"
   "1d_side_ff|pmma_1d_side.yaml|integrator.fast_forward=true"
   "1d_top|pmma_1d_top.yaml|"
