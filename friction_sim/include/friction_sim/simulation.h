@@ -112,6 +112,8 @@ class Simulation : public Dynamics {
   bool stageTooFast() const { return std::abs(stage_.velocity()) > quasi_static_stage_speed_; }
   void refreshAfterStaticChange();
   void reapplyFriction();
+  /// J, of the slider at its current velocities.
+  double kineticEnergy() const { return 0.5 * node_mass_ * v_.squaredNorm(); }
   /// Sets the stop reason once a stop condition holds. Called every step.
   void checkStop();
   /// Composes the stop reason; kept out of checkStop, whose every-step test it would otherwise slow

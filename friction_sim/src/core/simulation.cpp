@@ -95,7 +95,7 @@ bool Simulation::relaxToStaticEquilibrium() {
   auto potential = [&](const Vector& u) {
     return model_->elasticEnergy(u, stage_.position()) - model_->externalWork(external_reference_u_, u);
   };
-  viscous_dissipation_ += potential(u_) + 0.5 * node_mass_ * v_.squaredNorm() - potential(relaxed);
+  viscous_dissipation_ += potential(u_) + kineticEnergy() - potential(relaxed);
   u_ = relaxed;
   v_.setZero();
   refreshAfterStaticChange();
@@ -197,13 +197,13 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   u_ += (stage_end - stage_start) * along;
   stage_.advance(jump);
   time_ += jump;
-  const double kinetic_before = 0.5 * node_mass_ * v_.squaredNorm();
+  const double kinetic_before = kineticEnergy();
   solver->solve(*model_, u_, stage_end);
   v_.swap(path_velocity);
   // Along the path every node moves with the stage: the stage supplies that kinetic energy, as in the
   // dynamics, where it accelerates the slider (otherwise the next relaxation would count it as
   // dissipated); kinetic energy lost when the stage stops rings down in the dynamics.
-  const double kinetic_change = 0.5 * node_mass_ * v_.squaredNorm() - kinetic_before;
+  const double kinetic_change = kineticEnergy() - kinetic_before;
   if (kinetic_change > 0.0) {
     pusher_work_ += kinetic_change;
   } else {
@@ -417,7 +417,7 @@ EnergyBudget Simulation::energy() const {
   budget.work_in = pusher_work_ + external_work_closed_ + model_->externalWork(external_reference_u_, u_);
   budget.elastic = model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_);
   budget.initial_elastic = initial_elastic_;
-  budget.kinetic = 0.5 * node_mass_ * v_.squaredNorm();
+  budget.kinetic = kineticEnergy();
   budget.friction_dissipation = contact_.frictionDissipation();
   budget.viscous_dissipation = viscous_dissipation_;
   return budget;
