@@ -109,12 +109,13 @@ std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* 
     const double holding = kRigid ? 0.0 - force : k_t * (anchor[node] - x[node]);
     friction[node] = frictionOf(stuck, holding, node_mu, normal[node], sign);
     force_to_acceleration[node] = (force + friction[node]) * inverse_mass;
-    // 0/1 flags as doubles. The weights are 0 or 1: stuck + |sign| is 1 unless the node is detached.
-    const double in_contact = normal[node] > 0.0 ? 1.0 : 0.0;
-    const double attached = stuck + std::abs(sign);
-    const double holding_in_contact = stuck * in_contact;
-    attention += (holding_in_contact > 0.0 && std::abs(friction[node]) > node_static_mu * normal[node]) ||
-                 in_contact != attached;
+    // The flags are integers, combined with & and | rather than && and ||: GCC may not compute a
+    // floating-point comparison or product that a branch would skip (it could trap), so with && the
+    // loop vectorises only with AVX-512's masks and stays scalar with AVX2.
+    const std::int64_t in_contact = normal[node] > 0.0;
+    const std::int64_t attached = mode[node] != 0.0;  // stuck or sliding
+    const std::int64_t over_threshold = std::abs(friction[node]) > node_static_mu * normal[node];
+    attention += ((stuck > 0.0) & in_contact & over_threshold) | (in_contact ^ attached);
   }
   return attention;
 }
