@@ -180,67 +180,7 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
     median = {name: statistics.median(values) for name, values in repetitions.items()}
     for name, values in repetitions.items():
         lines.append("| %s | %.2f | %.2f – %.2f |" % (name, median[name], min(values), max(values)))
-    chain_fixed_cost = 57 * (median["chainStep/57"] - median["chainStep/1000"])
-    two_block_step = 2 * median["chainStep/2"]
-    short_chain_step = 57 * median["chainStep/57"]
-    stream_small, stream_large = median["stateStream/1767"], median["stateStream/1002001"]
-    leapfrog_large = median["leapfrogStream/1002001"]
-    lattice = {name: value for name, value in median.items() if "geometric" in name}
-    largest = lattice.pop("latticeStep/geometric/1001/1001")
-    wide_rows = lattice.pop("latticeStep/geometric/1001/61")
-    smaller = statistics.median(lattice.values())
-    excess = largest - smaller
-    memory_extra = stream_large - stream_small  # what a plain stream pays for memory over cache
-    row_width = ("The width of its rows is not the cause: a 1001 × 61 lattice, with the same rows and a state that "
-                 "fits the last-level cache, costs %.2f ns." % wide_rows if wide_rows < 1.1 * smaller else
-                 "A 1001 × 61 lattice, with the same rows and a state that fits the last-level cache, costs %.2f ns: "
-                 "wide rows cost more too." % wide_rows)
-    stalls = ("more than a plain stream pays for memory: memory stalls cost the step more than they cost a stream, "
-              "presumably because each strip is read in a burst before its forces are computed, with little "
-              "arithmetic left to hide it" if excess > memory_extra else
-              "no more than a plain stream pays for memory")
-    lines += ["", "The lattice's step is one sweep over the state: the model evaluates the forces in strips of about "
-              "4096 nodes (whole rows), and velocity Verlet's kick-and-drift and closing kick run on each strip "
-              "while it is in the L2 cache (`StripHooks`). With separate passes a 10⁶-node step streamed its "
-              "displacements, velocities and accelerations from memory five times and cost 6.6–9.4 ns per "
-              "node-step. Now 10⁶ nodes cost %.2f ns, %.2f× the median of the smaller lattices (%.2f ns). %s Velocity Verlet's traffic alone, "
-              "each node's displacements, velocities and accelerations read and written once with a force that costs "
-              "nothing (`stateStream`), costs %.2f ns per node at 10⁶ nodes (%.0f GB/s) and %.2f ns in cache: "
-              "memory adds %.2f ns to a plain stream. The large lattice's step costs %.2f ns more than the smaller "
-              "ones' median, %s. Measured by hand on 2026-11-24 with a standalone loop of the same 6-array stream, "
-              "its cost per node is 0.45–0.5 ns while the arrays fit the L2 cache, about 0.67 ns up to 12 MB, "
-              "1.1 ns at 24 MB, 1.4 ns at 48 MB and 1.7 ns at 96 MB: every lattice up to 449 × 241 (under 6 MB of "
-              "displacements, velocities and accelerations) streams from the last-level cache, the 10⁶-node one "
-              "(48 MB) from memory, the only one. Storing half-step velocities in place of the accelerations "
-              "(leapfrog) would stream 4 numbers per node instead of 6: `leapfrogStream` costs %.2f ns per node at "
-              "10⁶ nodes, %.2f× `stateStream` here, and 0.75–1.0× in repeated runs by hand on 2026-11-24 (this "
-              "host's speed drifts): at most about a quarter of the traffic's cost, for a change of integrator whose "
-              "end-of-step velocities the friction rules read. A flat cost needs fewer passes over memory: two "
-              "steps per sweep (temporal blocking). It is not done: the simulation's callers (the node's "
-              "instruments, the offline runner's loading curve) read the state after every step, and the contact, "
-              "friction, event and fast-forward logic between two steps decides whether the next one is a plain "
-              "step at all, so a sweep of two steps would have to guess and roll back. The chain driven at its "
-              "side (pmma_1d_side) is swept the same way: F_X, and with it every block's normal force, is known "
-              "once block 0 is prepared, so each strip's friction is applied as soon as the strip is finished "
-              "(driven from the top, F_X is a sum over every block and the chain keeps separate passes). At 57 "
-              "blocks a step costs %.0f ns more than 57 blocks' share of a 10³-block step, and a 2-block step "
-              "costs %.0f ns: %.0f %% of a 57-block step (%.0f ns) is a fixed cost. Counted by hand with callgrind "
-              "on 2026-11-24, that fixed cost is about 1050 instructions per step spread over some fifteen "
-              "functions: the force evaluation with the normal forces 29 %%, the friction pass and its dispatch "
-              "21 %%, the integrator's passes and the strip plumbing 17 %%, the contact's state bookkeeping 11 %%, "
-              "the step's own logic 10 %%, the stage 4 %%, the event detector 3 %%, the rest 5 %%; none alone is "
-              "worth a rewrite. Built for CPUs with AVX2 but not AVX-512 (`scripts/build.sh "
-              "-DFRICTION_SIM_NATIVE=OFF -DCMAKE_CXX_FLAGS=-march=x86-64-v3`), measured by hand on 2026-11-24 on "
-              "this machine: 1.41 ns per block-step at 10³ blocks, 2.21 at 57, and 5.6 ns per node-step at "
-              "57 × 31. At 10⁵ "
-              "blocks it streams 9 arrays of one number per block once per step. It writes 6: displacements, "
-              "velocities, forces turned accelerations, the normal forces, the friction and the other forces. It only "
-              "reads each node's friction mode (stuck, sliding direction or detached) and the 2 of the normal-force "
-              "profile (1 without tilt): Amontons–Coulomb's µ_s and µ_k are read as two numbers, and with rigid "
-              "sticking the anchors are not read." % (
-                  largest, largest / smaller, smaller, row_width, stream_large, 96.0 / stream_large,
-                  stream_small, memory_extra, excess, stalls, leapfrog_large, leapfrog_large / stream_large,
-                  chain_fixed_cost, two_block_step, 100.0 * two_block_step / short_chain_step, short_chain_step)]
+    lines += ["", kernels_discussion(median)]
     lines += ["", "## Whole runs: wall time and peak memory", "",
               "Each in a fresh process; wall time includes building the model, the stability limit and the loading "
               "solve.", "", "| run | wall (s) | peak memory (MB) |", "|---|---|---|"]
@@ -340,6 +280,81 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
               "rewrite left its events unchanged to the printed digits)."]
     open(os.path.join(ROOT, "docs/PERFORMANCE.md"), "w").write("\n".join(lines) + "\n")
 
+
+
+def kernels_discussion(median):
+    """The paragraph under the kernels' table: what the medians say about the lattice's cost over sizes
+    and the chain's fixed cost, with the hand measurements (dated) that explain them."""
+    stream_small, stream_large = median["stateStream/1767"], median["stateStream/1002001"]
+    lattice = {name: value for name, value in median.items() if "geometric" in name}
+    largest = lattice.pop("latticeStep/geometric/1001/1001")
+    wide_rows = lattice.pop("latticeStep/geometric/1001/61")
+    smaller = statistics.median(lattice.values())
+    excess = largest - smaller
+    memory_extra = stream_large - stream_small  # what a plain stream pays for memory over cache
+    if wide_rows < 1.1 * smaller:
+        row_width = ("The width of its rows is not the cause: a 1001 × 61 lattice, with the same rows and a state "
+                     "that fits the last-level cache, costs %.2f ns." % wide_rows)
+    else:
+        row_width = ("A 1001 × 61 lattice, with the same rows and a state that fits the last-level cache, costs "
+                     "%.2f ns: wide rows cost more too." % wide_rows)
+    if excess > memory_extra:
+        stalls = ("more than a plain stream pays for memory: memory stalls cost the step more than they cost a "
+                  "stream, presumably because each strip is read in a burst before its forces are computed, with "
+                  "little arithmetic left to hide it")
+    else:
+        stalls = "no more than a plain stream pays for memory"
+    leapfrog_large = median["leapfrogStream/1002001"]
+    chain_fixed_cost = 57 * (median["chainStep/57"] - median["chainStep/1000"])
+    two_block_step = 2 * median["chainStep/2"]
+    short_chain_step = 57 * median["chainStep/57"]
+    sentences = [
+        "The lattice's step is one sweep over the state: the model evaluates the forces in strips of about 4096 "
+        "nodes (whole rows), and velocity Verlet's kick-and-drift and closing kick run on each strip while it is "
+        "in the L2 cache (`StripHooks`). With separate passes a 10⁶-node step streamed its displacements, "
+        "velocities and accelerations from memory five times and cost 6.6–9.4 ns per node-step.",
+        "Now 10⁶ nodes cost %.2f ns, %.2f× the median of the smaller lattices (%.2f ns)." % (
+            largest, largest / smaller, smaller),
+        row_width,
+        "Velocity Verlet's traffic alone, each node's displacements, velocities and accelerations read and written "
+        "once with a force that costs nothing (`stateStream`), costs %.2f ns per node at 10⁶ nodes (%.0f GB/s) "
+        "and %.2f ns in cache: memory adds %.2f ns to a plain stream." % (
+            stream_large, 96.0 / stream_large, stream_small, memory_extra),
+        "The large lattice's step costs %.2f ns more than the smaller ones' median, %s." % (excess, stalls),
+        "Measured by hand on 2026-11-24 with a standalone loop of the same 6-array stream, its cost per node is "
+        "0.45–0.5 ns while the arrays fit the L2 cache, about 0.67 ns up to 12 MB, 1.1 ns at 24 MB, 1.4 ns at "
+        "48 MB and 1.7 ns at 96 MB: every lattice up to 449 × 241 (under 6 MB of displacements, velocities and "
+        "accelerations) streams from the last-level cache, the 10⁶-node one (48 MB) from memory, the only one.",
+        "Storing half-step velocities in place of the accelerations (leapfrog) would stream 4 numbers per node "
+        "instead of 6: `leapfrogStream` costs %.2f ns per node at 10⁶ nodes, %.2f× `stateStream` here, and "
+        "0.75–1.0× in repeated runs by hand on 2026-11-24 (this host's speed drifts): at most about a quarter of "
+        "the traffic's cost, for a change of integrator whose end-of-step velocities the friction rules read." % (
+            leapfrog_large, leapfrog_large / stream_large),
+        "A flat cost needs fewer passes over memory: two steps per sweep (temporal blocking). It is not done: the "
+        "simulation's callers (the node's instruments, the offline runner's loading curve) read the state after "
+        "every step, and the contact, friction, event and fast-forward logic between two steps decides whether "
+        "the next one is a plain step at all, so a sweep of two steps would have to guess and roll back.",
+        "The chain driven at its side (pmma_1d_side) is swept the same way: F_X, and with it every block's normal "
+        "force, is known once block 0 is prepared, so each strip's friction is applied as soon as the strip is "
+        "finished (driven from the top, F_X is a sum over every block and the chain keeps separate passes).",
+        "At 57 blocks a step costs %.0f ns more than 57 blocks' share of a 10³-block step, and a 2-block step "
+        "costs %.0f ns: %.0f %% of a 57-block step (%.0f ns) is a fixed cost." % (
+            chain_fixed_cost, two_block_step, 100.0 * two_block_step / short_chain_step, short_chain_step),
+        "Counted by hand with callgrind on 2026-11-24, that fixed cost is about 1050 instructions per step spread "
+        "over some fifteen functions: the force evaluation with the normal forces 29 %, the friction pass and its "
+        "dispatch 21 %, the integrator's passes and the strip plumbing 17 %, the contact's state bookkeeping "
+        "11 %, the step's own logic 10 %, the stage 4 %, the event detector 3 %, the rest 5 %; none alone is "
+        "worth a rewrite.",
+        "Built for CPUs with AVX2 but not AVX-512 (`scripts/build.sh -DFRICTION_SIM_NATIVE=OFF "
+        "-DCMAKE_CXX_FLAGS=-march=x86-64-v3`), measured by hand on 2026-11-24 on this machine: 1.41 ns per "
+        "block-step at 10³ blocks, 2.21 at 57, and 5.6 ns per node-step at 57 × 31.",
+        "At 10⁵ blocks it streams 9 arrays of one number per block once per step. It writes 6: displacements, "
+        "velocities, forces turned accelerations, the normal forces, the friction and the other forces. It only "
+        "reads each node's friction mode (stuck, sliding direction or detached) and the 2 of the normal-force "
+        "profile (1 without tilt): Amontons–Coulomb's µ_s and µ_k are read as two numbers, and with rigid "
+        "sticking the anchors are not read.",
+    ]
+    return " ".join(sentences)
 
 def cpu_model():
     for line in open("/proc/cpuinfo"):
