@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# Runs the same thirteen scenes with two builds of friction_run and says whether their results are
+# Runs the same fourteen scenes with two builds of friction_run and says whether their results are
 # byte-identical: the check behind "results unchanged" for a change meant to be speed only.
 #
 #   scripts/compare_outputs.sh REFERENCE_RUNNER CANDIDATE_RUNNER [WORK_DIR]
 #
-# The scenes cover the 1D chain (side- and top-driven, tilted) and the 2D lattice (geometric and linear
+# The scenes cover the 1D chain (side- and top-driven, tilted, with the torque term) and the 2D lattice (geometric and linear
 # springs; one lattice wider than the force sweep's column chunks), Amontons–Coulomb and slip weakening, velocity Verlet and RK4, fast-forward on and off.
 # Every results file is compared except the summary's wall-time line. Exit status 0 if all are identical,
-# 1 if any differ (the differing files are listed), 2 on a usage error. About 45 s (26 runs).
+# 1 if any differ (the differing files are listed), 2 on a usage error. About 50 s (28 runs).
 set -euo pipefail
 
 if [[ $# -lt 2 || $# -gt 3 ]]; then
@@ -32,6 +32,7 @@ cases=(
   "1d_side_ff|pmma_1d_side.yaml|integrator.fast_forward=true"
   "1d_top|pmma_1d_top.yaml|"
   "1d_tilt|pmma_1d_side.yaml|chain.tilt=0.3"
+  "1d_torque|pmma_1d_side.yaml|chain.torque_share=1.0 pusher.height=0.005"
   "1d_sw|pmma_1d_side.yaml|friction.law=slip_weakening"
   "block|single_block.yaml|"
 )

@@ -5,6 +5,22 @@
 
 namespace friction {
 
+namespace {
+/// N, the tension of the bond between blocks i and i + 1: spring plus pair damping.
+inline double bondTension(double k, double eta, const double* x, const double* w, int i) {
+  return k * (x[i + 1] - x[i]) + eta * (w[i + 1] - w[i]);
+}
+
+/// The bond forces f_i = T_i − T_{i−1} on the interior blocks [first, end). Each tension is computed for
+/// both of its blocks rather than stored: one pass that vectorises, with the round-off of a stored
+/// tension. Static, with restrict parameters, because GCC honours restrict only on parameters (without
+/// it the loop carries run-time alias checks, as long as its arithmetic at 57 blocks).
+void bondForces(int first, int end, double k, double eta, const double* __restrict x, const double* __restrict w,
+                double* __restrict f) {
+  for (int i = first; i < end; ++i) f[i] = bondTension(k, eta, x, w, i) - bondTension(k, eta, x, w, i - 1);
+}
+}  // namespace
+
 Chain1D::Chain1D(const Scene& scene)
     : n_(scene.chain.blocks),
       length_(scene.geometry.length),
@@ -50,15 +66,22 @@ auto Chain1D::normalForceExpression(double shear_force, int first, int count) co
 }
 
 void Chain1D::writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const {
+  const double load_share = normal_force_ / n_;
+  double* normal = normal_forces.data() + first;
+  // Plain loops rather than an Eigen expression: at the default 57 blocks the expression's set-up cost
+  // as much as its arithmetic. Without tilt the tilt profile is exactly 1, and without torque every
+  // block carries F_Z/N: the same numbers without reading the profiles.
+  if (torque_share_ == 0.0 && tilt_ == 0.0) {
+    std::fill_n(normal, count, std::max(load_share, 0.0));
+    return;
+  }
   const double torque = torqueCoefficient(shear_force);
-  auto write = [&](const auto& load_share) {
-    normal_forces.segment(first, count) = (load_share + torque * xi_.segment(first, count)).max(0.0);
-  };
-  // Without tilt the tilt profile is exactly 1: the same numbers without reading it.
+  const double* xi = xi_.data() + first;
   if (tilt_ == 0.0) {
-    write(normal_force_ / n_);
+    for (int i = 0; i < count; ++i) normal[i] = std::max(load_share + torque * xi[i], 0.0);
   } else {
-    write(normal_force_ / n_ * tilt_factor_.segment(first, count));
+    const double* tilt = tilt_factor_.data() + first;
+    for (int i = 0; i < count; ++i) normal[i] = std::max(load_share * tilt[i] + torque * xi[i], 0.0);
   }
 }
 
@@ -93,17 +116,15 @@ void Chain1D::evaluateInStrips(const Vector& u, const Vector& v, double stage_po
 void Chain1D::evaluateTopDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
                                 ForceEvaluation& out) const {
   force.resize(n_);
-  const double* __restrict x = u.data();
-  const double* __restrict w = v.data();
-  double* __restrict f = force.data();
-  // The tension of the bond between blocks i and i + 1, computed for both of its blocks rather than
-  // stored: one pass that vectorises, with the round-off of a stored tension.
-  auto tension = [&](int i) { return k_ * (x[i + 1] - x[i]) + eta_ * (w[i + 1] - w[i]); };
+  const double* x = u.data();
+  const double* w = v.data();
+  double* f = force.data();
+  auto tension = [&](int i) { return bondTension(k_, eta_, x, w, i); };
   if (n_ == 1) {
     f[0] = 0.0;
   } else {
     f[0] = tension(0);
-    for (int i = 1; i + 1 < n_; ++i) f[i] = tension(i) - tension(i - 1);
+    bondForces(1, n_ - 1, k_, eta_, x, w, f);
     f[n_ - 1] = -tension(n_ - 2);
   }
   const auto driving = driving_stiffness_ * (stage_position + pusher_offset_.array() - u.array());
@@ -120,11 +141,10 @@ void Chain1D::evaluateSideDriven(const Vector& u, const Vector& v, double stage_
                                  ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const {
   force.resize(n_);
   out.normal_force.resize(n_);
-  const double* __restrict x = u.data();
-  const double* __restrict w = v.data();
-  double* __restrict f = force.data();
-  // As in evaluateTopDriven, each tension is computed for both of its blocks.
-  auto tension = [&](int i) { return k_ * (x[i + 1] - x[i]) + eta_ * (w[i + 1] - w[i]); };
+  const double* x = u.data();
+  const double* w = v.data();
+  double* f = force.data();
+  auto tension = [&](int i) { return bondTension(k_, eta_, x, w, i); };
   int prepared = 0;
   auto prepareThrough = [&](int end) {
     if (prepared >= end) return;
@@ -143,7 +163,7 @@ void Chain1D::evaluateSideDriven(const Vector& u, const Vector& v, double stage_
     prepareThrough(std::min(n_, end + 1));  // the last block's bond reads the next strip's first block
     const int bonds_end = std::min(end, n_ - 1);  // the bonds whose left block is in the strip
     f[first] = (first < n_ - 1 ? tension(first) : 0.0) - left_tension;
-    for (int i = first + 1; i < bonds_end; ++i) f[i] = tension(i) - tension(i - 1);
+    bondForces(first + 1, bonds_end, k_, eta_, x, w, f);
     if (end == n_ && first < n_ - 1) f[n_ - 1] = -tension(n_ - 2);
     if (first == 0) f[0] += shear;
     const int count = end - first;
