@@ -32,7 +32,7 @@ cases=(
   "1d_side_ff|pmma_1d_side.yaml|integrator.fast_forward=true"
   "1d_top|pmma_1d_top.yaml|"
   "1d_tilt|pmma_1d_side.yaml|chain.tilt=0.3"
-  "1d_torque|pmma_1d_side.yaml|chain.torque_share=1.0 pusher.height=0.005"
+  "1d_torque|pmma_1d_side.yaml|chain.torque_share=1.0"
   "1d_sw|pmma_1d_side.yaml|friction.law=slip_weakening"
   "block|single_block.yaml|"
 )

@@ -321,6 +321,11 @@ def kernels_discussion(median):
         "and %.2f ns in cache: memory adds %.2f ns to a plain stream." % (
             stream_large, 96.0 / stream_large, stream_small, memory_extra),
         "The large lattice's step costs %.2f ns more than the smaller ones' median, %s." % (excess, stalls),
+        "A sampling profile by hand on 2026-11-24 (`perf record -e cpu-clock`) puts the whole excess in the "
+        "strips' preparation, velocity Verlet's kick-and-drift, the first pass to touch a strip: 1.64 ns per node "
+        "at 10⁶ nodes against 0.76 ns at 1001 × 61, while the bond loops and the gathering of the forces cost "
+        "the same in both. Prefetching the next strip's rows into the L2 cache while the current rows' forces "
+        "are computed made the step slower again that day (6.05 against 5.34 ns, fastest of 9 interleaved runs).",
         "Measured by hand on 2026-11-24 with a standalone loop of the same 6-array stream, its cost per node is "
         "0.45–0.5 ns while the arrays fit the L2 cache, about 0.67 ns up to 12 MB, 1.1 ns at 24 MB, 1.4 ns at "
         "48 MB and 1.7 ns at 96 MB: every lattice up to 449 × 241 (under 6 MB of displacements, velocities and "
@@ -340,19 +345,25 @@ def kernels_discussion(median):
         "At 57 blocks a step costs %.0f ns more than 57 blocks' share of a 10³-block step, and a 2-block step "
         "costs %.0f ns: %.0f %% of a 57-block step (%.0f ns) is a fixed cost." % (
             chain_fixed_cost, two_block_step, 100.0 * two_block_step / short_chain_step, short_chain_step),
-        "Counted by hand with callgrind on 2026-11-24, that fixed cost is about 1050 instructions per step spread "
-        "over some fifteen functions: the force evaluation with the normal forces 29 %, the friction pass and its "
-        "dispatch 21 %, the integrator's passes and the strip plumbing 17 %, the contact's state bookkeeping "
-        "11 %, the step's own logic 10 %, the stage 4 %, the event detector 3 %, the rest 5 %; none alone is "
-        "worth a rewrite.",
+        "Counted by hand with callgrind on 2026-11-24 (in an AVX2 build: valgrind does not run AVX-512), after the "
+        "trim below, that fixed cost is about 970 instructions per step spread over some fifteen functions: the force evaluation "
+        "with the normal forces 28 %, the integrator's passes and the strip plumbing 26 %, the friction pass and "
+        "its dispatch 15 %, the contact's state bookkeeping 12 %, the step's own logic 12 %, the stage 5 %, the "
+        "event detector 3 %.",
+        "Two of the step's loops were trimmed on 2026-11-24: the bond forces run without "
+        "run-time alias checks, and without tilt or torque every normal force is F_Z/N, written without reading "
+        "the profile or computing the torque term from F_X. By hand (interleaved with the build before, median "
+        "of 21) that took a 57-block step from 2.03 to 1.86 ns per block-step, with the same results byte for "
+        "byte.",
         "Built for CPUs with AVX2 but not AVX-512 (`scripts/build.sh -DFRICTION_SIM_NATIVE=OFF "
-        "-DCMAKE_CXX_FLAGS=-march=x86-64-v3`), measured by hand on 2026-11-24 on this machine: 1.41 ns per "
-        "block-step at 10³ blocks, 2.21 at 57, and 5.6 ns per node-step at 57 × 31.",
-        "At 10⁵ blocks it streams 9 arrays of one number per block once per step. It writes 6: displacements, "
-        "velocities, forces turned accelerations, the normal forces, the friction and the other forces. It only "
-        "reads each node's friction mode (stuck, sliding direction or detached) and the 2 of the normal-force "
-        "profile (1 without tilt): Amontons–Coulomb's µ_s and µ_k are read as two numbers, and with rigid "
-        "sticking the anchors are not read.",
+        "-DCMAKE_CXX_FLAGS=-march=x86-64-v3`), measured by hand on 2026-11-24 on this machine (interleaved, "
+        "median of 21): 1.37 ns per block-step at 10³ blocks, 2.11 at 57, and 5.45 ns per node-step at 57 × 31.",
+        "At 10⁵ blocks, in the default scene held with every block stuck, it streams 7 arrays of one number per "
+        "block once per step. It writes 6: displacements, velocities, forces turned accelerations, the normal "
+        "forces, the friction and the other forces. It only reads each node's friction mode (stuck, sliding "
+        "direction or detached). The normal-force profile (ξ, and 1 + θξ with tilt) is read only with tilt or "
+        "the torque term, Amontons–Coulomb's µ_s and µ_k are read as two numbers, with rigid sticking the "
+        "anchors are not read, and a sliding block adds its position, velocity and friction at the step's start.",
     ]
     return " ".join(sentences)
 

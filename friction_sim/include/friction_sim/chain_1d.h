@@ -69,12 +69,12 @@ class Chain1D : public Model {
       add(i + 1, i, -coefficient);
     }
   }
-  /// N per block, w_i before clamping at zero, as an Eigen expression (no allocation in the step).
   void evaluateTopDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
                          ForceEvaluation& out) const;
   void evaluateSideDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
                           ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const;
-  /// w_i of blocks [first, first + count) at the given F_X (N), before clamping at 0.
+  /// w_i (N) of blocks [first, first + count) at the given F_X (N), before clamping at 0, as an Eigen
+  /// expression: no allocation for the callers that store it.
   auto normalForceExpression(double shear_force, int first, int count) const;
   /// Writes the normal forces (N), w_i clamped at 0, of blocks [first, first + count) into `normal_forces`.
   void writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const;

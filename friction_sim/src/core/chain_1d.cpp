@@ -13,8 +13,9 @@ inline double bondTension(double k, double eta, const double* x, const double* w
 
 /// The bond forces f_i = T_i − T_{i−1} on the interior blocks [first, end). Each tension is computed for
 /// both of its blocks rather than stored: one pass that vectorises, with the round-off of a stored
-/// tension. Static, with restrict parameters, because GCC honours restrict only on parameters (without
-/// it the loop carries run-time alias checks, as long as its arithmetic at 57 blocks).
+/// tension. A function of its own, with restrict parameters, because GCC honours restrict only on
+/// parameters: without it the loop carries run-time alias checks, which at 57 blocks take about as long
+/// as its arithmetic.
 void bondForces(int first, int end, double k, double eta, const double* __restrict x, const double* __restrict w,
                 double* __restrict f) {
   for (int i = first; i < end; ++i) f[i] = bondTension(k, eta, x, w, i) - bondTension(k, eta, x, w, i - 1);
@@ -68,9 +69,9 @@ auto Chain1D::normalForceExpression(double shear_force, int first, int count) co
 void Chain1D::writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const {
   const double load_share = normal_force_ / n_;
   double* normal = normal_forces.data() + first;
-  // Plain loops rather than an Eigen expression: at the default 57 blocks the expression's set-up cost
+  // Plain loops rather than an Eigen expression: at the default 57 blocks the expression's set-up costs
   // as much as its arithmetic. Without tilt the tilt profile is exactly 1, and without torque every
-  // block carries F_Z/N: the same numbers without reading the profiles.
+  // block carries F_Z/N: the same numbers (for a finite F_X) without reading the profiles.
   if (torque_share_ == 0.0 && tilt_ == 0.0) {
     std::fill_n(normal, count, std::max(load_share, 0.0));
     return;
