@@ -281,7 +281,6 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
     open(os.path.join(ROOT, "docs/PERFORMANCE.md"), "w").write("\n".join(lines) + "\n")
 
 
-
 def kernels_discussion(median):
     """The paragraph under the kernels' table: what the medians say about the lattice's cost over sizes
     and the chain's fixed cost, with the hand measurements (dated) that explain them."""
@@ -345,16 +344,15 @@ def kernels_discussion(median):
         "At 57 blocks a step costs %.0f ns more than 57 blocks' share of a 10³-block step, and a 2-block step "
         "costs %.0f ns: %.0f %% of a 57-block step (%.0f ns) is a fixed cost." % (
             chain_fixed_cost, two_block_step, 100.0 * two_block_step / short_chain_step, short_chain_step),
-        "Counted by hand with callgrind on 2026-11-24 (in an AVX2 build: valgrind does not run AVX-512), after the "
-        "trim below, that fixed cost is about 970 instructions per step spread over some fifteen functions: the force evaluation "
-        "with the normal forces 28 %, the integrator's passes and the strip plumbing 26 %, the friction pass and "
-        "its dispatch 15 %, the contact's state bookkeeping 12 %, the step's own logic 12 %, the stage 5 %, the "
-        "event detector 3 %.",
-        "Two of the step's loops were trimmed on 2026-11-24: the bond forces run without "
-        "run-time alias checks, and without tilt or torque every normal force is F_Z/N, written without reading "
-        "the profile or computing the torque term from F_X. By hand (interleaved with the build before, median "
-        "of 21) that took a 57-block step from 2.03 to 1.86 ns per block-step, with the same results byte for "
-        "byte.",
+        "Counted by hand with callgrind on 2026-11-24 (in an AVX2 build: valgrind does not run AVX-512), after "
+        "the trim below, that fixed cost is about 970 instructions per step spread over some fifteen functions: "
+        "the force evaluation with the normal forces 28 %, the integrator's passes and the strip plumbing 26 %, "
+        "the friction pass and its dispatch 15 %, the contact's state bookkeeping 12 %, the step's own logic "
+        "12 %, the stage 5 %, the event detector 3 %.",
+        "Two of the step's loops were trimmed on 2026-11-24: the bond forces run without run-time alias checks, "
+        "and without tilt or torque every normal force is F_Z/N, written without reading the profile or "
+        "computing the torque term from F_X. By hand (interleaved with the build before, median of 21) that took "
+        "a 57-block step from 2.03 to 1.86 ns per block-step, with the same results byte for byte.",
         "Built for CPUs with AVX2 but not AVX-512 (`scripts/build.sh -DFRICTION_SIM_NATIVE=OFF "
         "-DCMAKE_CXX_FLAGS=-march=x86-64-v3`), measured by hand on 2026-11-24 on this machine (interleaved, "
         "median of 21): 1.37 ns per block-step at 10³ blocks, 2.11 at 57, and 5.45 ns per node-step at 57 × 31.",
@@ -366,6 +364,7 @@ def kernels_discussion(median):
         "anchors are not read, and a sliding block adds its position, velocity and friction at the step's start.",
     ]
     return " ".join(sentences)
+
 
 def cpu_model():
     for line in open("/proc/cpuinfo"):

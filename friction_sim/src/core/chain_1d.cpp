@@ -67,23 +67,13 @@ auto Chain1D::normalForceExpression(double shear_force, int first, int count) co
 }
 
 void Chain1D::writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const {
-  const double load_share = normal_force_ / n_;
-  double* normal = normal_forces.data() + first;
-  // Plain loops rather than an Eigen expression: at the default 57 blocks the expression's set-up costs
-  // as much as its arithmetic. Without tilt the tilt profile is exactly 1, and without torque every
-  // block carries F_Z/N: the same numbers (for a finite F_X) without reading the profiles.
+  // Without tilt or torque every block carries F_Z/N: the same numbers (for a finite F_X) written as one
+  // constant, because at the default 57 blocks evaluating the profile costs as much as the bond forces.
   if (torque_share_ == 0.0 && tilt_ == 0.0) {
-    std::fill_n(normal, count, std::max(load_share, 0.0));
+    std::fill_n(normal_forces.data() + first, count, std::max(normal_force_ / n_, 0.0));
     return;
   }
-  const double torque = torqueCoefficient(shear_force);
-  const double* xi = xi_.data() + first;
-  if (tilt_ == 0.0) {
-    for (int i = 0; i < count; ++i) normal[i] = std::max(load_share + torque * xi[i], 0.0);
-  } else {
-    const double* tilt = tilt_factor_.data() + first;
-    for (int i = 0; i < count; ++i) normal[i] = std::max(load_share * tilt[i] + torque * xi[i], 0.0);
-  }
+  normal_forces.segment(first, count) = normalForceExpression(shear_force, first, count).max(0.0);
 }
 
 std::vector<double> Chain1D::normalForces(double shear_force) const {
