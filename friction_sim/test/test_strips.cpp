@@ -91,5 +91,89 @@ TEST(ChainStrips, SideDrivenStripsGiveTheForcesOfOneSweepAndKeepTheHookContract)
   expectStripsGiveOneSweep(chain, u, 1e-5, {1, 4, 5, 23}, 1e-12);
 }
 
+/// Two velocity Verlet evaluations (VerletPasses hooks, the forces used as accelerations) of `model`
+/// from (u, v, a) with the stage at `stage_first` then `stage_second`, swept together
+/// (evaluateTwoInStrips) and one after the other: the state and both evaluations must be the same bit
+/// for bit. `between` must find the interface's forces final, and when it declines the second
+/// evaluation the first must still complete alone.
+void expectTwoSweepsGiveTwoEvaluations(const Model& model, const Vector& u, double stage_first, double stage_second,
+                                       const std::vector<int>& strip_sizes) {
+  const int n = model.dofCount();
+  const double dt = 2e-9;
+  Vector v(n), a(n);
+  for (int i = 0; i < n; ++i) {
+    v[i] = 1e-3 * std::cos(0.21 * i);
+    a[i] = 1e3 * std::sin(0.7 * i + 0.3);
+  }
+  for (int strip_nodes : strip_sizes) {
+    auto evaluateOnce = [&](Vector& u_now, Vector& v_now, Vector& a_now, double stage, ForceEvaluation& out) {
+      VerletPasses passes(u_now, v_now, a_now, dt);
+      model.evaluateInStrips(u_now, v_now, stage, a_now, out, passes, strip_nodes);
+    };
+    Vector u_one = u, v_one = v, a_one = a;
+    ForceEvaluation first_one, second_one;
+    evaluateOnce(u_one, v_one, a_one, stage_first, first_one);
+    const Vector interface_after_first = a_one.segment(model.interfaceDof(0), model.interfaceNodeCount());
+    const Vector u_after_first = u_one, v_after_first = v_one, a_after_first = a_one;
+    evaluateOnce(u_one, v_one, a_one, stage_second, second_one);
+    for (bool go_on : {true, false}) {
+      SCOPED_TRACE(::testing::Message() << strip_nodes << (go_on ? " both" : " first only"));
+      Vector u_two = u, v_two = v, a_two = a;
+      ForceEvaluation first_two, second_two;
+      VerletPasses first_passes(u_two, v_two, a_two, dt), second_passes(u_two, v_two, a_two, dt);
+      int calls = 0;
+      const bool both = model.evaluateTwoInStrips(
+          {u_two, v_two, stage_first, a_two, first_two, first_passes},
+          {u_two, v_two, stage_second, a_two, second_two, second_passes}, strip_nodes, [&] {
+            ++calls;
+            EXPECT_TRUE((a_two.segment(model.interfaceDof(0), model.interfaceNodeCount()).array() ==
+                         interface_after_first.array()).all());
+            return go_on;
+          });
+      EXPECT_EQ(calls, 1);
+      EXPECT_EQ(both, go_on);
+      EXPECT_EQ(first_two.shear_force, first_one.shear_force);
+      EXPECT_EQ(first_two.normal_load, first_one.normal_load);
+      EXPECT_EQ(first_two.viscous_power, first_one.viscous_power);
+      EXPECT_TRUE((first_two.normal_force.array() == first_one.normal_force.array()).all());
+      if (!go_on) {
+        EXPECT_TRUE((u_two.array() == u_after_first.array()).all());
+        EXPECT_TRUE((v_two.array() == v_after_first.array()).all());
+        EXPECT_TRUE((a_two.array() == a_after_first.array()).all());
+        EXPECT_EQ(second_two.normal_force.size(), 0);
+        continue;
+      }
+      EXPECT_TRUE((u_two.array() == u_one.array()).all());
+      EXPECT_TRUE((v_two.array() == v_one.array()).all());
+      EXPECT_TRUE((a_two.array() == a_one.array()).all());
+      EXPECT_EQ(second_two.shear_force, second_one.shear_force);
+      EXPECT_EQ(second_two.normal_load, second_one.normal_load);
+      EXPECT_EQ(second_two.viscous_power, second_one.viscous_power);
+      EXPECT_TRUE((second_two.normal_force.array() == second_one.normal_force.array()).all());
+    }
+  }
+}
+
+TEST(LatticeStrips, TwoStepsSweptTogetherGiveTheTwoStepsOneAfterTheOther) {
+  for (int variant : {0, 1}) {
+    SCOPED_TRACE(variant);
+    const Lattice2D lattice(latticeStripScene(variant));
+    const int n = lattice.dofCount();
+    Vector u(n);
+    for (int i = 0; i < n; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0) - (i >= n / 2 ? 1e-6 : 0.0);
+    // Strips of one, two and three rows of 21 nodes, and the whole lattice as one strip.
+    expectTwoSweepsGiveTwoEvaluations(lattice, u, 1e-5, 1.1e-5, {21, 2 * 21, 3 * 21, n});
+  }
+}
+
+TEST(ChainStrips, TwoStepsEvaluatedTogetherGiveTheTwoStepsOneAfterTheOther) {
+  Scene scene = testing::torqueChainScene(23);
+  scene.chain.tilt = 0.3;
+  const Chain1D chain(scene);
+  Vector u(23);
+  for (int i = 0; i < 23; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0);
+  expectTwoSweepsGiveTwoEvaluations(chain, u, 1e-5, 1.1e-5, {4, 23});
+}
+
 }  // namespace
 }  // namespace friction

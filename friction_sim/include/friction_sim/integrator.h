@@ -31,6 +31,28 @@ class Integrator {
                       double dt) = 0;
 };
 
+/// Velocity Verlet's passes over the state, run by a force evaluation strip by strip (StripHooks): a
+/// range is kicked and drifted when prepared, while its accelerations are still those of the step's
+/// start, and given its closing kick when finished.
+class VerletPasses : public StripHooks {
+ public:
+  /// (u, v) in m and m/s, `a` in m/s², dt in s; all kept by reference.
+  VerletPasses(Vector& u, Vector& v, const Vector& a, double dt);
+  void prepare(int first, int end) override;
+  void finish(int first, int end) override;
+
+ private:
+  // Static, with restrict parameters: GCC honours restrict only on parameters.
+  static void kickAndDrift(int count, double half_dt, double dt, const double* __restrict acceleration,
+                           double* __restrict velocity, double* __restrict displacement);
+  static void kick(int count, double half_dt, const double* __restrict acceleration, double* __restrict velocity);
+
+  double* displacement_;
+  double* velocity_;
+  const double* acceleration_;
+  double dt_, half_dt_;
+};
+
 /// Kick–drift–kick velocity Verlet; velocity-dependent forces are evaluated with the half-step velocity.
 /// Its passes run inside the force evaluation's strips (Dynamics::accelerationInStrips).
 class VelocityVerlet : public Integrator {

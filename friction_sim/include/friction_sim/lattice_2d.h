@@ -39,6 +39,10 @@ class Lattice2D : public Model {
   /// Strips of whole rows; the external forces on a row are added before it is finished.
   void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
                         ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const override;
+  /// The second evaluation sweeps a strip or two behind the first, through the first's finished rows.
+  bool evaluateTwoInStrips(const StripEvaluation& first, const StripEvaluation& second, int strip_nodes,
+                           const std::function<bool()>& between) const override;
+  bool sweepsTwoAtOnce() const override { return true; }
   /// The foundation's force k_f·(−u_z) on each bottom node.
   Vector signedNormalForces(const Vector& u, const ForceEvaluation& evaluation) const override;
   double elasticEnergy(const Vector& u, double stage_position) const override;
@@ -89,16 +93,28 @@ class Lattice2D : public Model {
   double pusher_k_per_row_;
   std::vector<double> pusher_offset_;  ///< m, u_x of each pushed node when the pusher was connected
   bool pusher_connected_ = true;
-  /// Work space of the force sweep: the bond forces (N, on the bond's lower-index node) of the current
-  /// row, along x (`horizontal`) and up to the next row (`upward`), and of the row below, zero-padded so
-  /// that the node loop needs no edge cases; and the viscous power (W) summed per column.
+  /// The bond forces (N, on the bond's lower-index node) from a row up to the next, zero-padded so that
+  /// the node loop needs no edge cases.
   struct RowBonds {
     std::vector<double> vertical_x, vertical_z, diagonal_x, diagonal_z, antidiagonal_x, antidiagonal_z;
     void resize(int size);
     void clear();
   };
-  mutable std::vector<double> horizontal_x_, horizontal_z_, column_power_;
-  mutable RowBonds upward_, below_;
+  /// Work space of one force sweep: the upward bond forces of the current row and of the row below, and
+  /// the viscous power (W) summed per column. Eigen's storage for the power: Eigen sums aligned packets
+  /// and adds the unaligned ends apart, so in a buffer of std::vector's alignment the total's last bits
+  /// would depend on where the heap put it.
+  struct SweepSpace {
+    RowBonds upward, below;
+    Eigen::ArrayXd column_power;
+  };
+  /// One force evaluation, row by row (lattice_2d.cpp).
+  class Sweep;
+  /// The bond forces along x of the row being swept, padded the same way; shared by the sweeps, which
+  /// take a whole row at a time.
+  mutable std::vector<double> horizontal_x_, horizontal_z_;
+  /// A sweep's own work space, and the second's while two run at once (evaluateTwoInStrips).
+  mutable std::array<SweepSpace, 2> sweep_space_;
 };
 
 }  // namespace friction

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <array>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -51,6 +52,16 @@ class StripHooks {
   virtual void finish(int /*first*/, int /*end*/) {}
 };
 
+/// One force evaluation of Model::evaluateTwoInStrips: the arguments of evaluateInStrips.
+struct StripEvaluation {
+  const Vector& u;         ///< m, displacements
+  const Vector& v;         ///< m/s, velocities
+  double stage_position;   ///< m
+  Vector& force;           ///< N, per degree of freedom (resized)
+  ForceEvaluation& out;    ///< the rest of the evaluation (its own `force` left alone)
+  StripHooks& hooks;
+};
+
 /// Stress tensor components at the gauge height, at the gauge positions (tension positive).
 struct GaugeStresses {
   std::vector<double> sigma_xx;  ///< Pa
@@ -81,6 +92,17 @@ class Model {
   /// prepared once and finished once. By default one strip: everything prepared, evaluated, finished.
   virtual void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
                                 ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const;
+  /// Two evaluations of successive steps: `first`; then, once the interface's forces and friction are
+  /// final (its strips finished), `between()`, which returns whether to go on; then `second`, which may
+  /// read the state only as `first`'s finish hooks leave it, and is read only after between() returns
+  /// (which may still fill it in). A model may sweep the second a few strips
+  /// behind the first, so that a large state crosses the memory bus once for both. Returns whether
+  /// `second` was evaluated. By default one after the other.
+  virtual bool evaluateTwoInStrips(const StripEvaluation& first, const StripEvaluation& second, int strip_nodes,
+                                   const std::function<bool()>& between) const;
+  /// Whether evaluateTwoInStrips sweeps the state once for both evaluations; if not, two steps taken
+  /// together cost a little more than two taken apart.
+  virtual bool sweepsTwoAtOnce() const { return false; }
   /// The same, with the forces in `out.force`.
   void evaluate(const Vector& u, const Vector& v, double stage_position, ForceEvaluation& out) const {
     evaluateInto(u, v, stage_position, out.force, out);

@@ -33,8 +33,12 @@ class Simulation : public Dynamics {
   /// Advances by one time step or, with fast-forward on while the interface sits in static equilibrium
   /// with no node sliding and the stage moves slowly, jumps along the equilibrium to the earliest of
   /// `until` (s), the stage's next change and just before the next node reaches its threshold, loses
-  /// contact or, lifted, lands (MODEL.md §5).
-  void advance(double until);
+  /// contact or, lifted, lands (MODEL.md §5). With `two_steps`, takes two plain steps instead of one when
+  /// both end by `until` and the first changes nothing at the interface (no node slides, none starts to,
+  /// no slip event is under way): the same results as two calls, with the state swept once for both
+  /// (Model::evaluateTwoInStrips). Velocity Verlet, and a model that sweeps two evaluations at once (the
+  /// 2D lattice), only. For callers that need the state after every step only around events.
+  void advance(double until, bool two_steps = false);
   /// Advances until the scene's stop condition holds.
   void run();
   /// True while the slider sits in static equilibrium with no node sliding (fast-forward can jump).
@@ -94,6 +98,27 @@ class Simulation : public Dynamics {
   /// off the track. Applies it (the energy of the ring-down it skips is counted as viscous dissipation)
   /// and returns true; otherwise leaves the state as it is.
   bool relaxToStaticEquilibrium();
+  /// What a step keeps from its start for its end.
+  struct StepStart {
+    long long contact_changes;  ///< the contact's lift-offs and landings so far
+    bool was_quasi_static;
+    bool stage_too_fast;
+    double shear_force;     ///< N, F_X
+    double stage_position;  ///< m
+  };
+  StepStart stepStart() const;
+  /// The clock and the stage a step on.
+  void advanceClock();
+  /// The energy of a step that dissipated `dissipated` (J) in the pair damping, and the pusher's work.
+  void accountStep(const StepStart& start, double dissipated);
+  /// The interface's re-sticking and its other state rules at the step's end.
+  void settleInterface();
+  /// Slip events, fast-forward's return to the static path and the stop condition after a step.
+  void concludeStep(const StepStart& start);
+  /// Whether advance(until, true) may take two steps in one sweep now.
+  bool mayStepTwice(double until) const;
+  /// Two steps of velocity Verlet in one sweep, or one if the first changes anything at the interface.
+  void stepTwice();
   /// The jumps of `advance`; returns false if a dynamic step is needed instead.
   bool fastForward(double until);
   /// One jump along the pinned equilibrium towards `until` or, if sooner, the next node's threshold
@@ -136,6 +161,8 @@ class Simulation : public Dynamics {
   double power_ = 0.0;  ///< W, viscous power at the current state
   /// The last force evaluation (friction excluded); its `force` stays empty, the forces go to a_.
   ForceEvaluation evaluation_;
+  /// The second step's evaluation while stepTwice sweeps two; then swapped into evaluation_.
+  ForceEvaluation second_evaluation_;
   bool event_ended_ = false;
   bool event_started_ = false;
   std::string stop_reason_;

@@ -16,37 +16,26 @@ double Dynamics::accelerationInStrips(const Vector& u, const Vector& v, double t
   return power;
 }
 
-namespace {
-/// Velocity Verlet's passes over the state, run by the force evaluation strip by strip. A range is
-/// prepared while its accelerations are still those of the step's start.
-class VerletPasses : public StripHooks {
- public:
-  VerletPasses(Vector& u, Vector& v, const Vector& a, double dt)
-      : displacement_(u.data()), velocity_(v.data()), acceleration_(a.data()), dt_(dt), half_dt_(0.5 * dt) {}
-  void prepare(int first, int end) override {
-    kickAndDrift(end - first, half_dt_, dt_, acceleration_ + first, velocity_ + first, displacement_ + first);
-  }
-  void finish(int first, int end) override { kick(end - first, half_dt_, acceleration_ + first, velocity_ + first); }
+VerletPasses::VerletPasses(Vector& u, Vector& v, const Vector& a, double dt)
+    : displacement_(u.data()), velocity_(v.data()), acceleration_(a.data()), dt_(dt), half_dt_(0.5 * dt) {}
 
- private:
-  // Static, with restrict parameters: GCC honours restrict only on parameters.
-  static void kickAndDrift(int count, double half_dt, double dt, const double* __restrict acceleration,
-                           double* __restrict velocity, double* __restrict displacement) {
-    for (int i = 0; i < count; ++i) {
-      velocity[i] += half_dt * acceleration[i];
-      displacement[i] += dt * velocity[i];
-    }
-  }
-  static void kick(int count, double half_dt, const double* __restrict acceleration, double* __restrict velocity) {
-    for (int i = 0; i < count; ++i) velocity[i] += half_dt * acceleration[i];
-  }
+void VerletPasses::prepare(int first, int end) {
+  kickAndDrift(end - first, half_dt_, dt_, acceleration_ + first, velocity_ + first, displacement_ + first);
+}
 
-  double* displacement_;
-  double* velocity_;
-  const double* acceleration_;
-  double dt_, half_dt_;
-};
-}  // namespace
+void VerletPasses::finish(int first, int end) { kick(end - first, half_dt_, acceleration_ + first, velocity_ + first); }
+
+void VerletPasses::kickAndDrift(int count, double half_dt, double dt, const double* __restrict acceleration,
+                                double* __restrict velocity, double* __restrict displacement) {
+  for (int i = 0; i < count; ++i) {
+    velocity[i] += half_dt * acceleration[i];
+    displacement[i] += dt * velocity[i];
+  }
+}
+
+void VerletPasses::kick(int count, double half_dt, const double* __restrict acceleration, double* __restrict velocity) {
+  for (int i = 0; i < count; ++i) velocity[i] += half_dt * acceleration[i];
+}
 
 double VelocityVerlet::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
                            double dt) {

@@ -48,9 +48,11 @@ Lattice2D::Lattice2D(const Scene& scene)
                {-1, 1, 0.5 * k_, diagonal, -c, c}};
   horizontal_x_.assign(nx_ + 2, 0.0);
   horizontal_z_.assign(nx_ + 2, 0.0);
-  column_power_.assign(nx_ + 2, 0.0);
-  upward_.resize(nx_ + 2);
-  below_.resize(nx_ + 2);
+  for (SweepSpace& space : sweep_space_) {
+    space.column_power.setZero(nx_ + 2);
+    space.upward.resize(nx_ + 2);
+    space.below.resize(nx_ + 2);
+  }
   // Start the mattress plate where it carries F_Z with the slider undeformed.
   plate_z_ = -normal_force_ / (nx_ * mattress_k_);
 }
@@ -125,6 +127,135 @@ void bondRow(const NodeArrays& nodes, int a0, int b0, int count, double rest_x, 
 
 }  // namespace
 
+/// One force evaluation swept row by row, in strips of whole rows: first every bond of the row
+/// (contiguous runs of nodes, so the loops vectorise), then each node's force gathered once from its eight
+/// bonds, half of them kept from the row below, then the external forces on the row. Buffer index p
+/// holds the bond whose lower-index node is at column p − 1 (p − 2 for the antidiagonal); the padding
+/// entries stay zero. A row at a time, so that a second sweep can follow this one (evaluateTwoInStrips).
+class Lattice2D::Sweep {
+ public:
+  Sweep(const Lattice2D& lattice, const StripEvaluation& evaluation, int strip_nodes, SweepSpace& space)
+      : lattice_(lattice),
+        evaluation_(evaluation),
+        space_(space),
+        rows_per_strip_(std::max(1, strip_nodes / lattice.nx_)),
+        bonds_(lattice.geometric_ ? &bondRow<true> : &bondRow<false>) {
+    evaluation_.force.resize(2 * lattice.n_);
+    evaluation_.out.normal_force.resize(lattice.nx_);
+    space_.column_power.setZero();
+    space_.below.clear();
+  }
+
+  bool done() const { return row_ == lattice_.nz_; }
+  /// Rows [0, finishedRows()) are finished: their forces final, their finish hooks called, their state
+  /// no longer read.
+  int finishedRows() const { return finished_rows_; }
+  /// Rows [0, preparedRowsForNextRow()) are prepared once the next row is swept: the bonds of row j
+  /// read rows j and j + 1, and rows are prepared a strip at a time.
+  int preparedRowsForNextRow() const {
+    const int rows_needed = std::min(lattice_.nz_, row_ + 2);
+    if (prepared_rows_ >= rows_needed) return prepared_rows_;
+    return std::min(lattice_.nz_, std::max(rows_needed, prepared_rows_ + rows_per_strip_));
+  }
+
+  void sweepRow() {
+    const Lattice2D& l = lattice_;
+    const int nx = l.nx_, nz = l.nz_, n = l.n_, j = row_;
+    const int prepared_end = preparedRowsForNextRow();
+    if (prepared_end > prepared_rows_) {
+      evaluation_.hooks.prepare(prepared_rows_ * nx, prepared_end * nx);
+      evaluation_.hooks.prepare(n + prepared_rows_ * nx, n + prepared_end * nx);
+      prepared_rows_ = prepared_end;
+    }
+    double* fx = evaluation_.force.data();
+    double* fz = evaluation_.force.data() + n;
+    const double* ux = evaluation_.u.data();
+    const double* uz = evaluation_.u.data() + n;
+    RowBonds& upward = space_.upward;
+    const RowBonds& below = space_.below;
+    const int row = j * nx, next = row + nx;
+    run(l.families_[0], row, row + 1, nx - 1, l.horizontal_x_.data() + 1, l.horizontal_z_.data() + 1);
+    if (j + 1 < nz) {
+      run(l.families_[1], row, next, nx, upward.vertical_x.data(), upward.vertical_z.data());
+      run(l.families_[2], row, next + 1, nx - 1, upward.diagonal_x.data() + 1, upward.diagonal_z.data() + 1);
+      run(l.families_[3], row + 1, next, nx - 1, upward.antidiagonal_x.data() + 2, upward.antidiagonal_z.data() + 2);
+    } else {
+      upward.clear();
+    }
+    auto gather = [nx](const double* __restrict h, const double* __restrict vu, const double* __restrict du,
+                       const double* __restrict au, const double* __restrict vb, const double* __restrict db,
+                       const double* __restrict ab, double* __restrict f) {
+      for (int i = 0; i < nx; ++i) {
+        f[i] = ((h[i + 1] - h[i]) + (vu[i] - vb[i])) + ((du[i + 1] - db[i]) + (au[i + 1] - ab[i + 2]));
+      }
+    };
+    gather(l.horizontal_x_.data(), upward.vertical_x.data(), upward.diagonal_x.data(), upward.antidiagonal_x.data(),
+           below.vertical_x.data(), below.diagonal_x.data(), below.antidiagonal_x.data(), fx + row);
+    gather(l.horizontal_z_.data(), upward.vertical_z.data(), upward.diagonal_z.data(), upward.antidiagonal_z.data(),
+           below.vertical_z.data(), below.diagonal_z.data(), below.antidiagonal_z.data(), fz + row);
+    std::swap(space_.upward, space_.below);
+    if (j == 0) {
+      for (int i = 0; i < nx; ++i) {
+        const double normal = l.kf_ * std::max(0.0, -uz[i]);
+        evaluation_.out.normal_force[i] = normal;
+        fz[i] += normal;
+      }
+    }
+    if (j == nz - 1) {
+      for (int i = 0; i < nx; ++i) {
+        const int top = l.nodeIndex(i, j);
+        if (l.mattress_) {
+          const double spring = l.topSpringForce(evaluation_.u, i);
+          fz[top] += spring;
+          fx[top] += l.mattress_kx_per_node_ * (l.top_anchor_x_[i] - ux[top]);
+          normal_sum_top_ -= spring;
+        } else {
+          fz[top] -= l.normal_force_ / nx;
+        }
+      }
+    }
+    for (; l.pusher_connected_ && next_pushed_ < l.pushed_rows_.size() && l.pushed_rows_[next_pushed_] == j;
+         ++next_pushed_) {
+      const int node = l.nodeIndex(0, j);
+      const double pusher_force =
+          l.pusher_k_per_row_ * (evaluation_.stage_position + l.pusher_offset_[next_pushed_] - ux[node]);
+      fx[node] += pusher_force;
+      shear_ += pusher_force;
+    }
+    if (j + 1 - finished_rows_ >= rows_per_strip_ || j == nz - 1) {
+      evaluation_.hooks.finish(finished_rows_ * nx, (j + 1) * nx);
+      evaluation_.hooks.finish(n + finished_rows_ * nx, n + (j + 1) * nx);
+      finished_rows_ = j + 1;
+    }
+    ++row_;
+  }
+
+  /// The evaluation's sums, once every row is swept.
+  void complete() {
+    evaluation_.out.viscous_power = space_.column_power.sum();
+    evaluation_.out.normal_load = lattice_.mattress_ ? normal_sum_top_ : lattice_.normal_force_;
+    evaluation_.out.shear_force = shear_;
+  }
+
+ private:
+  void run(const BondFamily& family, int a0, int b0, int count, double* out_x, double* out_z) {
+    const NodeArrays nodes{evaluation_.u.data(), evaluation_.u.data() + lattice_.n_, evaluation_.v.data(),
+                           evaluation_.v.data() + lattice_.n_};
+    bonds_(nodes, a0, b0, count, family.ex * family.rest_length, family.ez * family.rest_length, family.rest_length,
+           family.stiffness, lattice_.eta_, out_x, out_z, space_.column_power.data());
+  }
+
+  const Lattice2D& lattice_;
+  const StripEvaluation evaluation_;  ///< a copy (of references): the caller's may be a temporary
+  SweepSpace& space_;
+  const int rows_per_strip_;
+  decltype(&bondRow<true>) bonds_;
+  int row_ = 0, prepared_rows_ = 0, finished_rows_ = 0;
+  double normal_sum_top_ = 0.0;  ///< N, the mattress's springs on the top row
+  double shear_ = 0.0;           ///< N, the pusher's force
+  std::size_t next_pushed_ = 0;  ///< the next pushed row, in pushed_rows_
+};
+
 void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                              ForceEvaluation& out) const {
   StripHooks none;
@@ -133,108 +264,32 @@ void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_posi
 
 void Lattice2D::evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
                                  ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const {
-  force.resize(2 * n_);
-  out.normal_force.resize(nx_);
-  double* fx = force.data();
-  double* fz = force.data() + n_;
-  const double* ux = u.data();
-  const double* uz = u.data() + n_;
-  const NodeArrays nodes{ux, uz, v.data(), v.data() + n_};
-  auto bonds = geometric_ ? &bondRow<true> : &bondRow<false>;
-  // Strips are whole rows: both dofs of rows [first_row, end_row).
-  auto prepare = [&](int first_row, int end_row) {
-    hooks.prepare(first_row * nx_, end_row * nx_);
-    hooks.prepare(n_ + first_row * nx_, n_ + end_row * nx_);
-  };
-  auto finish = [&](int first_row, int end_row) {
-    hooks.finish(first_row * nx_, end_row * nx_);
-    hooks.finish(n_ + first_row * nx_, n_ + end_row * nx_);
-  };
-  const int rows_per_strip = std::max(1, strip_nodes / nx_);
-  int prepared_rows = 0, finished_rows = 0;
-  // Row by row: first every bond of the row (contiguous runs of nodes, so the loops vectorise), then
-  // each node's force gathered once from its eight bonds, half of them kept from the row below, then
-  // the external forces on the row. Buffer index p holds the bond whose lower-index node is at column
-  // p − 1 (p − 2 for the antidiagonal); the padding entries stay zero.
-  const BondFamily& horizontal = families_[0];
-  const BondFamily& vertical = families_[1];
-  const BondFamily& diagonal = families_[2];
-  const BondFamily& antidiagonal = families_[3];
-  auto run = [&](const BondFamily& family, int a0, int b0, int count, double* out_x, double* out_z) {
-    bonds(nodes, a0, b0, count, family.ex * family.rest_length, family.ez * family.rest_length,
-          family.rest_length, family.stiffness, eta_, out_x, out_z, column_power_.data());
-  };
-  std::fill(column_power_.begin(), column_power_.end(), 0.0);
-  below_.clear();
-  double normal_sum_top = 0.0, shear = 0.0;
-  std::size_t next_pushed = 0;
-  for (int j = 0; j < nz_; ++j) {
-    // The bonds of row j read rows j and j + 1.
-    const int rows_needed = std::min(nz_, j + 2);
-    if (prepared_rows < rows_needed) {
-      const int end_row = std::min(nz_, std::max(rows_needed, prepared_rows + rows_per_strip));
-      prepare(prepared_rows, end_row);
-      prepared_rows = end_row;
-    }
-    const int row = j * nx_, next = row + nx_;
-    run(horizontal, row, row + 1, nx_ - 1, horizontal_x_.data() + 1, horizontal_z_.data() + 1);
-    if (j + 1 < nz_) {
-      run(vertical, row, next, nx_, upward_.vertical_x.data(), upward_.vertical_z.data());
-      run(diagonal, row, next + 1, nx_ - 1, upward_.diagonal_x.data() + 1, upward_.diagonal_z.data() + 1);
-      run(antidiagonal, row + 1, next, nx_ - 1, upward_.antidiagonal_x.data() + 2,
-          upward_.antidiagonal_z.data() + 2);
-    } else {
-      upward_.clear();
-    }
-    auto gather = [&](const double* __restrict h, const double* __restrict vu, const double* __restrict du,
-                      const double* __restrict au, const double* __restrict vb, const double* __restrict db,
-                      const double* __restrict ab, double* __restrict f) {
-      for (int i = 0; i < nx_; ++i) {
-        f[i] = ((h[i + 1] - h[i]) + (vu[i] - vb[i])) + ((du[i + 1] - db[i]) + (au[i + 1] - ab[i + 2]));
-      }
-    };
-    gather(horizontal_x_.data(), upward_.vertical_x.data(), upward_.diagonal_x.data(),
-           upward_.antidiagonal_x.data(), below_.vertical_x.data(), below_.diagonal_x.data(),
-           below_.antidiagonal_x.data(), fx + row);
-    gather(horizontal_z_.data(), upward_.vertical_z.data(), upward_.diagonal_z.data(),
-           upward_.antidiagonal_z.data(), below_.vertical_z.data(), below_.diagonal_z.data(),
-           below_.antidiagonal_z.data(), fz + row);
-    std::swap(upward_, below_);
-    if (j == 0) {
-      for (int i = 0; i < nx_; ++i) {
-        const double normal = kf_ * std::max(0.0, -uz[i]);
-        out.normal_force[i] = normal;
-        fz[i] += normal;
+  Sweep sweep(*this, {u, v, stage_position, force, out, hooks}, strip_nodes, sweep_space_[0]);
+  while (!sweep.done()) sweep.sweepRow();
+  sweep.complete();
+}
+
+bool Lattice2D::evaluateTwoInStrips(const StripEvaluation& first, const StripEvaluation& second, int strip_nodes,
+                                    const std::function<bool()>& between) const {
+  Sweep leading(*this, first, strip_nodes, sweep_space_[0]);
+  // The interface is the bottom row: final once the first strip is finished.
+  while (leading.finishedRows() == 0) leading.sweepRow();
+  const bool both = between();
+  if (both) {
+    Sweep trailing(*this, second, strip_nodes, sweep_space_[1]);
+    // As close behind as it may go: it prepares (changes) only rows the leading sweep has finished.
+    while (!trailing.done()) {
+      if (trailing.preparedRowsForNextRow() <= leading.finishedRows()) {
+        trailing.sweepRow();
+      } else {
+        leading.sweepRow();
       }
     }
-    if (j == nz_ - 1) {
-      for (int i = 0; i < nx_; ++i) {
-        const int top = nodeIndex(i, j);
-        if (mattress_) {
-          const double spring = topSpringForce(u, i);
-          fz[top] += spring;
-          fx[top] += mattress_kx_per_node_ * (top_anchor_x_[i] - ux[top]);
-          normal_sum_top -= spring;
-        } else {
-          fz[top] -= normal_force_ / nx_;
-        }
-      }
-    }
-    for (; pusher_connected_ && next_pushed < pushed_rows_.size() && pushed_rows_[next_pushed] == j; ++next_pushed) {
-      const int node = nodeIndex(0, j);
-      const double pusher_force = pusher_k_per_row_ * (stage_position + pusher_offset_[next_pushed] - ux[node]);
-      fx[node] += pusher_force;
-      shear += pusher_force;
-    }
-    if (j + 1 - finished_rows >= rows_per_strip || j == nz_ - 1) {
-      finish(finished_rows, j + 1);
-      finished_rows = j + 1;
-    }
+    trailing.complete();
   }
-  out.viscous_power =
-      Eigen::Map<const Eigen::ArrayXd>(column_power_.data(), static_cast<Eigen::Index>(column_power_.size())).sum();
-  out.normal_load = mattress_ ? normal_sum_top : normal_force_;
-  out.shear_force = shear;
+  while (!leading.done()) leading.sweepRow();
+  leading.complete();
+  return both;
 }
 
 Vector Lattice2D::signedNormalForces(const Vector& u, const ForceEvaluation&) const {

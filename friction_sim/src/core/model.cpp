@@ -12,6 +12,14 @@ void Model::evaluateInStrips(const Vector& u, const Vector& v, double stage_posi
   hooks.finish(0, dofCount());
 }
 
+bool Model::evaluateTwoInStrips(const StripEvaluation& first, const StripEvaluation& second, int strip_nodes,
+                                const std::function<bool()>& between) const {
+  evaluateInStrips(first.u, first.v, first.stage_position, first.force, first.out, first.hooks, strip_nodes);
+  if (!between()) return false;
+  evaluateInStrips(second.u, second.v, second.stage_position, second.force, second.out, second.hooks, strip_nodes);
+  return true;
+}
+
 std::vector<int> Model::blockedDofsDuringLoading() const {
   std::vector<int> dofs;
   for (int node = 0; node < interfaceNodeCount(); ++node) dofs.push_back(interfaceDof(node));
