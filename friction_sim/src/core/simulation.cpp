@@ -363,8 +363,7 @@ void Simulation::stepTwice() {
   // With no node sliding, finishStep has nothing to re-stick: the interface's end of the first step is
   // its state update alone (settleInterface), made as soon as the interface is final. The second step
   // goes on only if that changes nothing: then no event starts, and the first step's conclusion cannot
-  // touch the state.
-  // Two pointers of captures: std::function keeps them without allocating.
+  // touch the state. Two pointers of captures, which std::function keeps without allocating.
   const bool both = model_->evaluateTwoInStrips(first_evaluation, second_evaluation, kTwoStepStripNodes,
                                                 [this, &second_evaluation] {
     if (contact_.updateStates(u_, v_, dt_, node_mass_)) {
