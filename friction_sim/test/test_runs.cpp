@@ -304,7 +304,7 @@ TEST(SimulationStrips, TwoStepAdvancesGiveTheRunOfSingleStepsThroughEvents) {
   scene.integrator.fast_forward = true;
   scene.load.top = TopLoadKind::SpringMattress;
   scene.friction.law = FrictionLawKind::SlipWeakening;
-  expectTwoStepAdvancesGiveTheRunOfSingleSteps(scene);
+  EXPECT_GT(expectTwoStepAdvancesGiveTheRunOfSingleSteps(scene), 0);
   // The chain evaluates two steps one after the other (nothing to gain): it takes them one at a time.
   EXPECT_EQ(expectTwoStepAdvancesGiveTheRunOfSingleSteps(loadScene(scenePath("pmma_1d_side"))), 0);
 }

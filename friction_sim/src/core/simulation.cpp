@@ -363,7 +363,8 @@ void Simulation::stepTwice() {
   // With no node sliding, finishStep has nothing to re-stick: the interface's end of the first step is
   // its state update alone (settleInterface), made as soon as the interface is final. The second step
   // goes on only if that changes nothing: then no event starts, and the first step's conclusion cannot
-  // touch the state. Two pointers of captures, which std::function keeps without allocating.
+  // touch the state. No force evaluation may run in between(): the first sweep is still under way in the
+  // model's work space. Two pointers of captures, which std::function keeps without allocating.
   const bool both = model_->evaluateTwoInStrips(first_evaluation, second_evaluation, kTwoStepStripNodes,
                                                 [this, &second_evaluation] {
     if (contact_.updateStates(u_, v_, dt_, node_mass_)) {
