@@ -67,13 +67,26 @@ Scene latticeStripScene(int variant) {
   return scene;
 }
 
+/// m, a rough displacement field of `n` degrees of freedom; with `pressed_in`, the second half (a
+/// lattice's u_z) shifted down so that the bottom row presses on the track.
+Vector roughDisplacements(int n, bool pressed_in) {
+  Vector u(n);
+  for (int i = 0; i < n; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0) - (pressed_in && i >= n / 2 ? 1e-6 : 0.0);
+  return u;
+}
+
+/// 23 blocks, with tilt and the torque term, so that every normal force depends on F_X.
+Scene tiltedTorqueChainScene() {
+  Scene scene = testing::torqueChainScene(23);
+  scene.chain.tilt = 0.3;
+  return scene;
+}
+
 TEST(LatticeStrips, StripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
   for (int variant : {0, 1}) {
     SCOPED_TRACE(variant);
     const Lattice2D lattice(latticeStripScene(variant));
-    const int n = lattice.dofCount();
-    Vector u(n);
-    for (int i = 0; i < n; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0) - (i >= n / 2 ? 1e-6 : 0.0);  // pressed in
+    const Vector u = roughDisplacements(lattice.dofCount(), true);
     // Strips of whole rows: one, two and three rows of 21 nodes. The power is summed column by column
     // over the whole sweep, so it is the same bit for bit.
     expectStripsGiveOneSweep(lattice, u, 1e-5, {1, 2 * 21, 3 * 21}, 0.0);
@@ -81,12 +94,8 @@ TEST(LatticeStrips, StripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
 }
 
 TEST(ChainStrips, SideDrivenStripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
-  // 23 blocks, with tilt and the torque term, so that every normal force depends on F_X.
-  Scene scene = testing::torqueChainScene(23);
-  scene.chain.tilt = 0.3;
-  const Chain1D chain(scene);
-  Vector u(23);
-  for (int i = 0; i < 23; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0);
+  const Chain1D chain(tiltedTorqueChainScene());
+  const Vector u = roughDisplacements(chain.dofCount(), false);
   // Strips of single blocks, of 4 and 5 (a shorter last strip) and one strip.
   expectStripsGiveOneSweep(chain, u, 1e-5, {1, 4, 5, 23}, 1e-12);
 }
@@ -158,21 +167,15 @@ TEST(LatticeStrips, TwoStepsSweptTogetherGiveTheTwoStepsOneAfterTheOther) {
   for (int variant : {0, 1}) {
     SCOPED_TRACE(variant);
     const Lattice2D lattice(latticeStripScene(variant));
-    const int n = lattice.dofCount();
-    Vector u(n);
-    for (int i = 0; i < n; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0) - (i >= n / 2 ? 1e-6 : 0.0);
+    const Vector u = roughDisplacements(lattice.dofCount(), true);
     // Strips of one, two and three rows of 21 nodes, and the whole lattice as one strip.
-    expectTwoSweepsGiveTwoEvaluations(lattice, u, 1e-5, 1.1e-5, {21, 2 * 21, 3 * 21, n});
+    expectTwoSweepsGiveTwoEvaluations(lattice, u, 1e-5, 1.1e-5, {21, 2 * 21, 3 * 21, lattice.dofCount()});
   }
 }
 
 TEST(ChainStrips, TwoStepsEvaluatedTogetherGiveTheTwoStepsOneAfterTheOther) {
-  Scene scene = testing::torqueChainScene(23);
-  scene.chain.tilt = 0.3;
-  const Chain1D chain(scene);
-  Vector u(23);
-  for (int i = 0; i < 23; ++i) u[i] = 2e-6 * std::sin(0.37 * i * i + 1.0);
-  expectTwoSweepsGiveTwoEvaluations(chain, u, 1e-5, 1.1e-5, {4, 23});
+  const Chain1D chain(tiltedTorqueChainScene());
+  expectTwoSweepsGiveTwoEvaluations(chain, roughDisplacements(chain.dofCount(), false), 1e-5, 1.1e-5, {4, 23});
 }
 
 }  // namespace
