@@ -334,12 +334,17 @@ def kernels_discussion(median):
         "0.75–1.0× in repeated runs by hand on 2026-11-24 (this host's speed drifts): at most about a quarter of "
         "the traffic's cost, for a change of integrator whose end-of-step velocities the friction rules read." % (
             leapfrog_large, leapfrog_large / stream_large),
-        "Fewer passes over memory: where nothing at the interface changes between two steps (no node slides or "
-        "starts to, no event is under way), two velocity Verlet steps are swept at once, the second step's "
-        "sweep two or three strips of about 2048 nodes behind the first's, so that a large state crosses the "
-        "memory bus once for both, with the same results byte for byte (`Simulation::advance(until, true)`, "
-        "which the offline runner uses between its loading-curve samples and the lattice cases above measure; "
-        "the ROS node, whose instruments read the state on their own clocks, steps one at a time). One step at "
+        "Fewer passes over memory: where nothing at the interface changes from one step to the next (no node "
+        "slides or starts to, no event is under way), up to three velocity Verlet steps are swept at once, each "
+        "step's sweep one or two strips of about 2048 nodes behind the one before, so that a large state "
+        "crosses the memory bus once for all of them, with the same results byte for byte "
+        "(`Simulation::advance(until, group_before)`, which the offline runner uses between its loading-curve "
+        "samples and the lattice cases above measure; the ROS node, whose instruments read the state on their "
+        "own clocks, steps one at a time). Interleaved by hand in one process on 2026-11-24 (fastest of 15 "
+        "rounds), the 10⁶-node lattice cost 5.38 ns per node-step one step at a time, 4.91 two at a time, "
+        "4.70 three, 4.66 four, 4.88 six and 5.12 eight (strips of 1024 nodes for six and eight); four cost a "
+        "1001 × 61 lattice 4 %% more than two (likely their row buffers, 100 kB a sweep at that width, crowding the L2 cache), three the "
+        "same, and the smaller lattices cost the same in groups as one step at a time. One step at "
         "a time (`latticeStepOneAtATime`) the 10⁶-node lattice costs %.2f ns per node-step, and %.2f at "
         "57 × 31." % (median["latticeStepOneAtATime/1001/1001"], median["latticeStepOneAtATime/57/31"]),
         "The chain driven at its side (pmma_1d_side) is swept the same way: F_X, and with it every block's normal "

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,11 +43,11 @@ benchmark::Counter nsPerNodeStep(double nodes, const benchmark::State& state) {
 /// Google Benchmark calls a case once per trial of its iteration count, and building a 10⁶-node
 /// simulation (loading solve, stability limit) takes about half a minute, so a case builds its
 /// simulation once and steps it on. Its state is a held equilibrium, so every step costs the same.
-/// Advances `simulation` as the offline runner does, two plain steps per advance where it may (here every
-/// step is plain), and sets the counter `name` to the ns per node-step (or block-step) of `nodes` nodes.
+/// Advances `simulation` as the offline runner does between its samples, several plain steps per advance
+/// where it may (here every step is plain), and sets the counter `name` to the ns per node-step (or block-step) of `nodes` nodes.
 void advanceAndCount(benchmark::State& state, Simulation& simulation, double nodes, const char* name) {
   const long long steps_before = simulation.steps();
-  for (auto _ : state) simulation.advance(simulation.scene().stop.time, true);
+  for (auto _ : state) simulation.advance(simulation.scene().stop.time, std::numeric_limits<double>::infinity());
   const double steps = static_cast<double>(simulation.steps() - steps_before);
   state.counters[name] =
       benchmark::Counter(nodes * steps * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
@@ -83,8 +84,8 @@ void latticeStep(benchmark::State& state, SpringForm form) {
 BENCHMARK_CAPTURE(latticeStep, geometric, SpringForm::Geometric)->Args({57, 31})->Args({32, 32})->Args({113, 61})->Args({225, 121})->Args({449, 241})
     ->Args({1001, 61})->Args({1001, 1001})->Unit(benchmark::kMicrosecond);
 
-/// The same lattice stepped one step per advance, each step a sweep of its own: what sweeping two steps
-/// at once saves.
+/// The same lattice stepped one step per advance, each step a sweep of its own: what sweeping several
+/// steps at once saves.
 void latticeStepOneAtATime(benchmark::State& state) {
   Simulation& simulation = reusedLattice(state, SpringForm::Geometric);
   for (auto _ : state) simulation.step();

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "friction_sim/chain_1d.h"
@@ -100,82 +102,90 @@ TEST(ChainStrips, SideDrivenStripsGiveTheForcesOfOneSweepAndKeepTheHookContract)
   expectStripsGiveOneSweep(chain, u, 1e-5, {1, 4, 5, 23}, 1e-12);
 }
 
-/// Two velocity Verlet evaluations (VerletPasses hooks, the forces used as accelerations) of `model`
-/// from (u, v, a) with the stage at `stage_first` then `stage_second`, swept together
-/// (evaluateTwoInStrips) and one after the other: the state and both evaluations must be the same bit
-/// for bit. `between` must find the interface's forces final, and when it declines the second
-/// evaluation the first must still complete alone.
-void expectTwoSweepsGiveTwoEvaluations(const Model& model, const Vector& u, double stage_first, double stage_second,
-                                       const std::vector<int>& strip_sizes) {
-  const int n = model.dofCount();
+/// Successive velocity Verlet evaluations (VerletPasses hooks, the forces used as accelerations) of
+/// `model` from (u, v, a), the stage at 1e-5 m, 1.1e-5 m, 1.2e-5 m, ..., swept together
+/// (evaluateSuccessiveInStrips) for every count up to the model's most, and one after the other: the
+/// state and every evaluation must be the same bit for bit. `next` must be asked for each evaluation
+/// once the one before has its interface final, also for the one past the most.
+void expectSuccessiveSweepsGiveSuccessiveEvaluations(const Model& model, const Vector& u,
+                                                     const std::vector<int>& strip_sizes) {
+  const int n = model.dofCount(), most = model.successiveEvaluations();
   const double dt = 2e-9;
+  auto stage = [](int k) { return 1e-5 * (1.0 + 0.1 * k); };
   Vector v(n), a(n);
   for (int i = 0; i < n; ++i) {
     v[i] = 1e-3 * std::cos(0.21 * i);
     a[i] = 1e3 * std::sin(0.7 * i + 0.3);
   }
+  auto interfaceOf = [&](const Vector& acceleration) {
+    return Vector(acceleration.segment(model.interfaceDof(0), model.interfaceNodeCount()));
+  };
   for (int strip_nodes : strip_sizes) {
-    auto evaluateOnce = [&](Vector& u_now, Vector& v_now, Vector& a_now, double stage, ForceEvaluation& out) {
-      VerletPasses passes(u_now, v_now, a_now, dt);
-      model.evaluateInStrips(u_now, v_now, stage, a_now, out, passes, strip_nodes);
-    };
+    // One after the other: the state after each evaluation, and the evaluations.
+    std::vector<Vector> u_after, v_after, a_after;
+    std::vector<ForceEvaluation> one(most);
     Vector u_one = u, v_one = v, a_one = a;
-    ForceEvaluation first_one, second_one;
-    evaluateOnce(u_one, v_one, a_one, stage_first, first_one);
-    const Vector interface_after_first = a_one.segment(model.interfaceDof(0), model.interfaceNodeCount());
-    const Vector u_after_first = u_one, v_after_first = v_one, a_after_first = a_one;
-    evaluateOnce(u_one, v_one, a_one, stage_second, second_one);
-    for (bool go_on : {true, false}) {
-      SCOPED_TRACE(::testing::Message() << strip_nodes << (go_on ? " both" : " first only"));
-      Vector u_two = u, v_two = v, a_two = a;
-      ForceEvaluation first_two, second_two;
-      VerletPasses first_passes(u_two, v_two, a_two, dt), second_passes(u_two, v_two, a_two, dt);
-      int calls = 0;
-      const bool both = model.evaluateTwoInStrips(
-          {u_two, v_two, stage_first, a_two, first_two, first_passes},
-          {u_two, v_two, stage_second, a_two, second_two, second_passes}, strip_nodes, [&] {
-            ++calls;
-            EXPECT_TRUE((a_two.segment(model.interfaceDof(0), model.interfaceNodeCount()).array() ==
-                         interface_after_first.array()).all());
-            return go_on;
-          });
-      EXPECT_EQ(calls, 1);
-      EXPECT_EQ(both, go_on);
-      EXPECT_EQ(first_two.shear_force, first_one.shear_force);
-      EXPECT_EQ(first_two.normal_load, first_one.normal_load);
-      EXPECT_EQ(first_two.viscous_power, first_one.viscous_power);
-      EXPECT_TRUE((first_two.normal_force.array() == first_one.normal_force.array()).all());
-      if (!go_on) {
-        EXPECT_TRUE((u_two.array() == u_after_first.array()).all());
-        EXPECT_TRUE((v_two.array() == v_after_first.array()).all());
-        EXPECT_TRUE((a_two.array() == a_after_first.array()).all());
-        EXPECT_EQ(second_two.normal_force.size(), 0);
-        continue;
-      }
-      EXPECT_TRUE((u_two.array() == u_one.array()).all());
-      EXPECT_TRUE((v_two.array() == v_one.array()).all());
-      EXPECT_TRUE((a_two.array() == a_one.array()).all());
-      EXPECT_EQ(second_two.shear_force, second_one.shear_force);
-      EXPECT_EQ(second_two.normal_load, second_one.normal_load);
-      EXPECT_EQ(second_two.viscous_power, second_one.viscous_power);
-      EXPECT_TRUE((second_two.normal_force.array() == second_one.normal_force.array()).all());
+    for (int k = 0; k < most; ++k) {
+      VerletPasses passes(u_one, v_one, a_one, dt);
+      model.evaluateInStrips(u_one, v_one, stage(k), a_one, one[k], passes, strip_nodes);
+      u_after.push_back(u_one);
+      v_after.push_back(v_one);
+      a_after.push_back(a_one);
     }
+    for (int count = 1; count <= most; ++count) {
+      SCOPED_TRACE(::testing::Message() << strip_nodes << " nodes per strip, " << count << " evaluations");
+      Vector u_together = u, v_together = v, a_together = a;
+      std::vector<ForceEvaluation> together(most);
+      VerletPasses passes(u_together, v_together, a_together, dt);
+      int asked = 0;
+      const int evaluated = model.evaluateSuccessiveInStrips(strip_nodes, [&](int k) -> std::optional<StripEvaluation> {
+        EXPECT_EQ(k, asked++);
+        if (k > 0) EXPECT_TRUE((interfaceOf(a_together).array() == interfaceOf(a_after[k - 1]).array()).all());
+        if (k == count) return std::nullopt;
+        return StripEvaluation{u_together, v_together, stage(k), a_together, together[k], passes};
+      });
+      EXPECT_EQ(evaluated, count);
+      EXPECT_EQ(asked, count + 1);
+      EXPECT_TRUE((u_together.array() == u_after[count - 1].array()).all());
+      EXPECT_TRUE((v_together.array() == v_after[count - 1].array()).all());
+      EXPECT_TRUE((a_together.array() == a_after[count - 1].array()).all());
+      for (int k = 0; k < most; ++k) {
+        if (k >= count) {
+          EXPECT_EQ(together[k].normal_force.size(), 0);
+          continue;
+        }
+        EXPECT_EQ(together[k].shear_force, one[k].shear_force);
+        EXPECT_EQ(together[k].normal_load, one[k].normal_load);
+        EXPECT_EQ(together[k].viscous_power, one[k].viscous_power);
+        EXPECT_TRUE((together[k].normal_force.array() == one[k].normal_force.array()).all());
+      }
+    }
+    // An evaluation past the most is refused.
+    Vector u_over = u, v_over = v, a_over = a;
+    ForceEvaluation over;
+    VerletPasses passes(u_over, v_over, a_over, dt);
+    EXPECT_THROW(model.evaluateSuccessiveInStrips(strip_nodes, [&](int) -> std::optional<StripEvaluation> {
+      return StripEvaluation{u_over, v_over, stage(0), a_over, over, passes};
+    }), std::logic_error);
   }
 }
 
-TEST(LatticeStrips, TwoStepsSweptTogetherGiveTheTwoStepsOneAfterTheOther) {
+TEST(LatticeStrips, SuccessiveStepsSweptTogetherGiveTheStepsOneAfterTheOther) {
   for (int variant : {0, 1}) {
     SCOPED_TRACE(variant);
     const Lattice2D lattice(latticeStripScene(variant));
+    ASSERT_GE(lattice.successiveEvaluations(), 3);
     const Vector u = roughDisplacements(lattice.dofCount(), true);
     // Strips of one, two and three rows of 21 nodes, and the whole lattice as one strip.
-    expectTwoSweepsGiveTwoEvaluations(lattice, u, 1e-5, 1.1e-5, {21, 2 * 21, 3 * 21, lattice.dofCount()});
+    expectSuccessiveSweepsGiveSuccessiveEvaluations(lattice, u, {21, 2 * 21, 3 * 21, lattice.dofCount()});
   }
 }
 
-TEST(ChainStrips, TwoStepsEvaluatedTogetherGiveTheTwoStepsOneAfterTheOther) {
+TEST(ChainStrips, TheChainEvaluatesOneStepAtATime) {
+  // Its state stays in the cache: sweeping several steps together would gain nothing.
   const Chain1D chain(tiltedTorqueChainScene());
-  expectTwoSweepsGiveTwoEvaluations(chain, roughDisplacements(chain.dofCount(), false), 1e-5, 1.1e-5, {4, 23});
+  EXPECT_EQ(chain.successiveEvaluations(), 1);
+  expectSuccessiveSweepsGiveSuccessiveEvaluations(chain, roughDisplacements(chain.dofCount(), false), {4, 23});
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "friction_sim/scene.h"
@@ -52,7 +53,7 @@ class StripHooks {
   virtual void finish(int /*first*/, int /*end*/) {}
 };
 
-/// One force evaluation of Model::evaluateTwoInStrips: the arguments of evaluateInStrips.
+/// One force evaluation of Model::evaluateSuccessiveInStrips: the arguments of evaluateInStrips.
 struct StripEvaluation {
   const Vector& u;         ///< m, displacements
   const Vector& v;         ///< m/s, velocities
@@ -92,17 +93,20 @@ class Model {
   /// prepared once and finished once. By default one strip: everything prepared, evaluated, finished.
   virtual void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
                                 ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const;
-  /// Two evaluations of successive steps: `first`; then, once the interface's forces and friction are
-  /// final (its strips finished), `between()`, which returns whether to go on; then `second`, which may
-  /// read the state only as `first`'s finish hooks leave it, and is read only after between() returns
-  /// (which may still fill it in). A model may sweep the second a few strips
-  /// behind the first, so that a large state crosses the memory bus once for both. Returns whether
-  /// `second` was evaluated. By default one after the other.
-  virtual bool evaluateTwoInStrips(const StripEvaluation& first, const StripEvaluation& second, int strip_nodes,
-                                   const std::function<bool()>& between) const;
-  /// Whether evaluateTwoInStrips sweeps the state once for both evaluations; if not, two steps taken
-  /// together cost a little more than two taken apart.
-  virtual bool sweepsTwoAtOnce() const { return false; }
+  /// Force evaluations of successive steps. `next(k)` gives evaluation k: first for k = 0, then for k ≥ 1
+  /// once evaluation k − 1's interface forces and friction are final (its strips finished); an empty answer
+  /// ends the series, and for k = successiveEvaluations() `next` must give none (it is still called, to
+  /// say that the last interface is final). Evaluation k may read the state only as evaluation k − 1's
+  /// finish hooks leave it; the sums of every evaluation (shear force, viscous power) are final only once
+  /// this returns. `next` may run no force evaluation: the sweeps are under way in the model's work space.
+  /// A model may sweep each evaluation a few strips behind the one before, so that a large state crosses
+  /// the memory bus once for all of them. Returns how many were evaluated. By default one, as
+  /// evaluateInStrips.
+  virtual int evaluateSuccessiveInStrips(int strip_nodes,
+                                         const std::function<std::optional<StripEvaluation>(int)>& next) const;
+  /// The most evaluations evaluateSuccessiveInStrips sweeps the state once for; 1 where sweeping several
+  /// together would gain nothing (the chain's state stays in the cache).
+  virtual int successiveEvaluations() const { return 1; }
   /// The same, with the forces in `out.force`.
   void evaluate(const Vector& u, const Vector& v, double stage_position, ForceEvaluation& out) const {
     evaluateInto(u, v, stage_position, out.force, out);

@@ -4,6 +4,7 @@
 // and keeping the energy budget. No ROS here: the offline runner and the ROS node both drive this.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -33,12 +34,14 @@ class Simulation : public Dynamics {
   /// Advances by one time step or, with fast-forward on while the interface sits in static equilibrium
   /// with no node sliding and the stage moves slowly, jumps along the equilibrium to the earliest of
   /// `until` (s), the stage's next change and just before the next node reaches its threshold, loses
-  /// contact or, lifted, lands (MODEL.md §5). With `two_steps`, takes two plain steps instead of one when
-  /// both end by `until` and the first changes nothing at the interface (no node slides, none starts to,
-  /// no slip event is under way): the same results as two calls, with the state swept once for both
-  /// (Model::evaluateTwoInStrips). Velocity Verlet, and a model that sweeps two evaluations at once (the
-  /// 2D lattice), only. For callers that need the state after every step only around events.
-  void advance(double until, bool two_steps = false);
+  /// contact or, lifted, lands (MODEL.md §5). Where the next two steps end before `group_before` (s), may
+  /// take several plain steps instead, each ending before `group_before`, for as long as each changes
+  /// nothing at the interface (no node slides, none starts to, no slip event is under way): the same
+  /// results as single steps, with the state swept once for all of them
+  /// (Model::evaluateSuccessiveInStrips). Velocity Verlet, and a model that sweeps several evaluations at
+  /// once (the 2D lattice), only. For callers that need the state after every step only around events
+  /// and at their own sample times.
+  void advance(double until, double group_before = 0.0);
   /// Advances until the scene's stop condition holds.
   void run();
   /// True while the slider sits in static equilibrium with no node sliding (fast-forward can jump).
@@ -109,16 +112,23 @@ class Simulation : public Dynamics {
   StepStart stepStart() const;
   /// The clock and the stage a step on.
   void advanceClock();
-  /// The energy of a step that dissipated `dissipated` (J) in the pair damping, and the pusher's work.
-  void accountStep(const StepStart& start, double dissipated);
+  /// The energy of a step that dissipated `dissipated` (J) in the pair damping, and the pusher's work up
+  /// to F_X = `end_shear_force` (N) with the stage at `end_stage_position` (m).
+  void accountStep(const StepStart& start, double end_shear_force, double end_stage_position, double dissipated);
   /// The interface's re-sticking and its other state rules at the step's end.
   void settleInterface();
   /// Slip events, fast-forward's return to the static path and the stop condition after a step.
   void concludeStep(const StepStart& start);
-  /// Whether advance(until, true) may take two steps in one sweep now.
-  bool mayStepTwice(double until) const;
-  /// Two steps of velocity Verlet in one sweep, or one if the first changes anything at the interface.
-  void stepTwice();
+  /// Whether advance(until, group_before) may take several steps in one sweep now.
+  bool mayStepInGroup(double group_before) const;
+  /// Steps of velocity Verlet in one sweep (Model::evaluateSuccessiveInStrips), each ending before
+  /// `group_before` (s), until one changes anything at the interface or ends the run.
+  void stepInGroup(double group_before);
+  /// The most steps stepInGroup takes in one sweep, whatever the model's successiveEvaluations(): the
+  /// 2D lattice's.
+  static constexpr int kMaxGroupSteps = 3;
+  /// Step k's force evaluation in stepInGroup.
+  ForceEvaluation& groupEvaluation(int k) { return k == 0 ? evaluation_ : later_evaluations_[k - 1]; }
   /// The jumps of `advance`; returns false if a dynamic step is needed instead.
   bool fastForward(double until);
   /// One jump along the pinned equilibrium towards `until` or, if sooner, the next node's threshold
@@ -161,8 +171,9 @@ class Simulation : public Dynamics {
   double power_ = 0.0;  ///< W, viscous power at the current state
   /// The last force evaluation (friction excluded); its `force` stays empty, the forces go to a_.
   ForceEvaluation evaluation_;
-  /// The second step's evaluation while stepTwice sweeps two; then swapped into evaluation_.
-  ForceEvaluation second_evaluation_;
+  /// The evaluations of a group's later steps while stepInGroup sweeps them; the last one is then
+  /// swapped into evaluation_.
+  std::array<ForceEvaluation, kMaxGroupSteps - 1> later_evaluations_;
   bool event_ended_ = false;
   bool event_started_ = false;
   std::string stop_reason_;

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <stdexcept>
+#include <string>
 
 namespace friction {
 
@@ -131,7 +134,7 @@ void bondRow(const NodeArrays& nodes, int a0, int b0, int count, double rest_x, 
 /// (contiguous runs of nodes, so the loops vectorise), then each node's force gathered once from its eight
 /// bonds, half of them kept from the row below, then the external forces on the row. Buffer index p
 /// holds the bond whose lower-index node is at column p − 1 (p − 2 for the antidiagonal); the padding
-/// entries stay zero. A row at a time, so that a second sweep can follow this one (evaluateTwoInStrips).
+/// entries stay zero. A row at a time, so that other sweeps can follow this one (evaluateSuccessiveInStrips).
 class Lattice2D::Sweep {
  public:
   Sweep(const Lattice2D& lattice, const StripEvaluation& evaluation, int strip_nodes, SweepSpace& space)
@@ -271,27 +274,40 @@ void Lattice2D::evaluateInStrips(const Vector& u, const Vector& v, double stage_
   sweep.complete();
 }
 
-bool Lattice2D::evaluateTwoInStrips(const StripEvaluation& first, const StripEvaluation& second, int strip_nodes,
-                                    const std::function<bool()>& between) const {
-  Sweep leading(*this, first, strip_nodes, sweep_space_[0]);
-  // The interface is the bottom row: final once the first strip is finished.
-  while (leading.finishedRows() == 0) leading.sweepRow();
-  const bool both = between();
-  if (both) {
-    Sweep trailing(*this, second, strip_nodes, sweep_space_[1]);
-    // As close behind as it may go: it prepares (changes) only rows the leading sweep has finished.
-    while (!trailing.done()) {
-      if (trailing.preparedRowsForNextRow() <= leading.finishedRows()) {
-        trailing.sweepRow();
-      } else {
-        leading.sweepRow();
+int Lattice2D::evaluateSuccessiveInStrips(int strip_nodes,
+                                          const std::function<std::optional<StripEvaluation>(int)>& next) const {
+  std::array<std::optional<Sweep>, kSuccessiveSweeps> sweeps;
+  const std::optional<StripEvaluation> first = next(0);
+  if (!first) return 0;
+  sweeps[0].emplace(*this, *first, strip_nodes, sweep_space_[0]);
+  int started = 1;
+  bool asking = true;
+  for (;;) {
+    const Sweep& hindmost = *sweeps[started - 1];
+    // The interface is the bottom row: final once a sweep's first strip is finished.
+    if (asking && hindmost.finishedRows() > 0) {
+      const std::optional<StripEvaluation> evaluation = next(started);
+      asking = evaluation.has_value();
+      if (asking) {
+        if (started == kSuccessiveSweeps) {
+          throw std::logic_error("Lattice2D::evaluateSuccessiveInStrips: asked for more than " +
+                                 std::to_string(kSuccessiveSweeps) + " evaluations");
+        }
+        sweeps[started].emplace(*this, *evaluation, strip_nodes, sweep_space_[started]);
+        ++started;
       }
+      continue;
     }
-    trailing.complete();
+    // A sweep is done only once the one ahead of it is.
+    if (hindmost.done()) break;
+    // The hindmost sweep that may go on, keeping them close: each prepares (changes) only rows that the
+    // one ahead of it has finished, and so have all the others ahead.
+    int k = started - 1;
+    while (k > 0 && sweeps[k]->preparedRowsForNextRow() > sweeps[k - 1]->finishedRows()) --k;
+    sweeps[k]->sweepRow();
   }
-  while (!leading.done()) leading.sweepRow();
-  leading.complete();
-  return both;
+  for (int k = 0; k < started; ++k) sweeps[k]->complete();
+  return started;
 }
 
 Vector Lattice2D::signedNormalForces(const Vector& u, const ForceEvaluation&) const {

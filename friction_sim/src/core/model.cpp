@@ -3,6 +3,8 @@
 #include "friction_sim/chain_1d.h"
 #include "friction_sim/lattice_2d.h"
 
+#include <stdexcept>
+
 namespace friction {
 
 void Model::evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
@@ -12,12 +14,17 @@ void Model::evaluateInStrips(const Vector& u, const Vector& v, double stage_posi
   hooks.finish(0, dofCount());
 }
 
-bool Model::evaluateTwoInStrips(const StripEvaluation& first, const StripEvaluation& second, int strip_nodes,
-                                const std::function<bool()>& between) const {
-  evaluateInStrips(first.u, first.v, first.stage_position, first.force, first.out, first.hooks, strip_nodes);
-  if (!between()) return false;
-  evaluateInStrips(second.u, second.v, second.stage_position, second.force, second.out, second.hooks, strip_nodes);
-  return true;
+int Model::evaluateSuccessiveInStrips(int strip_nodes,
+                                      const std::function<std::optional<StripEvaluation>(int)>& next) const {
+  for (int count = 0;; ++count) {
+    const std::optional<StripEvaluation> evaluation = next(count);
+    if (!evaluation) return count;
+    if (count == successiveEvaluations()) {
+      throw std::logic_error("Model::evaluateSuccessiveInStrips: asked for more evaluations than successiveEvaluations()");
+    }
+    evaluateInStrips(evaluation->u, evaluation->v, evaluation->stage_position, evaluation->force, evaluation->out,
+                     evaluation->hooks, strip_nodes);
+  }
 }
 
 std::vector<int> Model::blockedDofsDuringLoading() const {

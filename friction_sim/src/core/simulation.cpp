@@ -224,10 +224,10 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   return true;
 }
 
-void Simulation::advance(double until, bool two_steps) {
+void Simulation::advance(double until, double group_before) {
   if (mayJump() && fastForward(until)) return;
-  if (two_steps && mayStepTwice(until)) {
-    stepTwice();
+  if (mayStepInGroup(group_before)) {
+    stepInGroup(group_before);
   } else {
     step();
   }
@@ -237,10 +237,10 @@ namespace {
 /// About 4·10³ nodes: the strip's displacements, velocities and accelerations (≈ 200 kB) stay in the
 /// L2 cache between the force evaluation and the integrator's passes.
 constexpr int kStripNodes = 4096;
-/// About 2·10³ nodes while two steps are swept at once: the trailing sweep keeps two or three strips
-/// behind the leading one in the cache. At 10⁶ nodes, 1024 and 2048 gave 4.8–5.1 ns per node-step,
-/// 4096 4.9–5.7 and 8192 5.5–6.0 (by hand, 2026-11-24).
-constexpr int kTwoStepStripNodes = 2048;
+/// About 2·10³ nodes while a group of steps is swept at once: each sweep keeps one or two strips behind
+/// the one ahead of it in the cache. At 10⁶ nodes with two steps per sweep, 1024 and 2048 gave 4.8–5.1 ns
+/// per node-step, 4096 4.9–5.7 and 8192 5.5–6.0 (by hand, 2026-11-24).
+constexpr int kGroupStripNodes = 2048;
 
 /// Turns each finished strip's forces into accelerations before passing it on: the interface's entries
 /// with their friction, which needs nothing beyond the strip's own nodes.
@@ -299,9 +299,10 @@ void Simulation::advanceClock() {
   ++steps_;
 }
 
-void Simulation::accountStep(const StepStart& start, double dissipated) {
+void Simulation::accountStep(const StepStart& start, double end_shear_force, double end_stage_position,
+                             double dissipated) {
   viscous_dissipation_ += dissipated;
-  pusher_work_ += 0.5 * (start.shear_force + evaluation_.shear_force) * (stage_.position() - start.stage_position);
+  pusher_work_ += 0.5 * (start.shear_force + end_shear_force) * (end_stage_position - start.stage_position);
 }
 
 void Simulation::settleInterface() {
@@ -331,65 +332,69 @@ void Simulation::step() {
   contact_.beginStep(u_, v_);
   const double dissipated = integrator_->step(*this, u_, v_, a_, power_, time_, dt_);
   advanceClock();
-  accountStep(start, dissipated);
+  accountStep(start, evaluation_.shear_force, stage_.position(), dissipated);
   settleInterface();
   concludeStep(start);
 }
 
-bool Simulation::mayStepTwice(double until) const {
-  // Without fast-forward's next try (mayJump() stays false through a step with no event).
-  if (scene_.integrator.scheme != IntegratorKind::VelocityVerlet || !model_->sweepsTwoAtOnce() || mayJump() ||
-      contact_.slidingCount() > 0 ||
-      detector_.inEvent() || !((time_ + dt_) + dt_ <= until)) {
-    return false;
-  }
-  // The first step must not end the run: the time limit, then the stage travel as Stage::advance will
-  // count it (global events need slip).
-  return time_ + dt_ < scene_.stop.time &&
-         stage_.travel() + std::abs(stage_.positionAfter(dt_) - stage_.position()) < scene_.stop.stage_travel;
+bool Simulation::mayStepInGroup(double group_before) const {
+  // Without fast-forward's next try: mayJump() stays false through steps with no event.
+  return scene_.integrator.scheme == IntegratorKind::VelocityVerlet && model_->successiveEvaluations() > 1 &&
+         !mayJump() && contact_.slidingCount() == 0 && !detector_.inEvent() && (time_ + dt_) + dt_ < group_before;
 }
 
-void Simulation::stepTwice() {
-  VerletPasses first_passes(u_, v_, a_, dt_), second_passes(u_, v_, a_, dt_);
-  AccelerationStrips first_strips(first_passes, a_, inverse_mass_, contact_, evaluation_, u_);
-  AccelerationStrips second_strips(second_passes, a_, inverse_mass_, contact_, second_evaluation_, u_);
-  const StripEvaluation first_evaluation{u_, v_, stage_.positionAfter((time_ + dt_) - time_), a_, evaluation_,
-                                         first_strips};
-  // Its stage position is known once the first step's clock has moved, in between.
-  StripEvaluation second_evaluation{u_, v_, 0.0, a_, second_evaluation_, second_strips};
-  const StepStart first = stepStart();
+void Simulation::stepInGroup(double group_before) {
+  // What the steps' sweeps share, and what each step keeps for its end. Captured by reference, with
+  // `this`: two pointers, which std::function keeps without allocating.
+  struct Group {
+    int most;
+    double before;  ///< s
+    VerletPasses passes;
+    std::array<StepStart, kMaxGroupSteps> starts;
+    std::array<std::optional<AccelerationStrips>, kMaxGroupSteps> strips;
+    bool last_concluded = true;
+  } group{std::min(model_->successiveEvaluations(), kMaxGroupSteps), group_before, VerletPasses(u_, v_, a_, dt_), {},
+          {}};
+  group.starts[0] = stepStart();
   contact_.beginStep(u_, v_);
-  contact_.lendNormalStorage(evaluation_.normal_force);
-  // With no node sliding, finishStep has nothing to re-stick: the interface's end of the first step is
-  // its state update alone (settleInterface), made as soon as the interface is final. The second step
-  // goes on only if that changes nothing: then no event starts, and the first step's conclusion cannot
-  // touch the state. No force evaluation may run in between(): the first sweep is still under way in the
-  // model's work space. Two pointers of captures, which std::function keeps without allocating.
-  const bool both = model_->evaluateTwoInStrips(first_evaluation, second_evaluation, kTwoStepStripNodes,
-                                                [this, &second_evaluation] {
-    if (contact_.updateStates(u_, v_, dt_, node_mass_)) {
-      reapplyFriction();
-      return false;
-    }
-    advanceClock();
-    contact_.beginStep(u_, v_);
-    contact_.lendNormalStorage(second_evaluation_.normal_force);
-    second_evaluation.stage_position = stage_.positionAfter((time_ + dt_) - time_);
-    return true;
-  });
-  // Velocity Verlet's dissipation, as VelocityVerlet::step counts it.
-  power_ = evaluation_.viscous_power;
-  if (!both) advanceClock();
-  accountStep(first, power_ * dt_);
-  concludeStep(first);
-  if (!both) return;
-  const StepStart second = stepStart();
-  std::swap(evaluation_, second_evaluation_);
-  power_ = evaluation_.viscous_power;
-  advanceClock();
-  accountStep(second, power_ * dt_);
-  settleInterface();
-  concludeStep(second);
+  const int steps = model_->evaluateSuccessiveInStrips(
+      kGroupStripNodes, [this, &group](int k) -> std::optional<StripEvaluation> {
+        if (k > 0) {
+          // Step k − 1's interface is final. With no node sliding, finishStep has nothing to re-stick: the
+          // interface's end of the step is its state update alone (settleInterface).
+          advanceClock();
+          if (contact_.updateStates(u_, v_, dt_, node_mass_)) {
+            reapplyFriction();
+            group.last_concluded = false;  // once its sums are known, below
+            return std::nullopt;
+          }
+          // Nothing changed at the interface, so no slip event starts or ends, nothing returns to the static
+          // path (which would evaluate forces while the sweeps are under way in the model's work space),
+          // and the step's conclusion needs none of the sums its sweep is still adding up (F_X, the
+          // viscous power).
+          concludeStep(group.starts[k - 1]);
+          if (k == group.most || finished() || !(time_ + dt_ < group.before)) return std::nullopt;
+          group.starts[k] = stepStart();
+          contact_.beginStep(u_, v_);
+        }
+        ForceEvaluation& evaluation = groupEvaluation(k);
+        contact_.lendNormalStorage(evaluation.normal_force);
+        group.strips[k].emplace(group.passes, a_, inverse_mass_, contact_, evaluation, u_);
+        return StripEvaluation{u_, v_, stage_.positionAfter((time_ + dt_) - time_), a_, evaluation,
+                               *group.strips[k]};
+      });
+  // The steps' energy, in order, now that their sums are known; the clock stands at the last one's end.
+  for (int k = 0; k < steps; ++k) {
+    const ForceEvaluation& evaluation = groupEvaluation(k);
+    StepStart& start = group.starts[k];
+    if (k > 0) start.shear_force = groupEvaluation(k - 1).shear_force;
+    const double end_stage_position = k + 1 < steps ? group.starts[k + 1].stage_position : stage_.position();
+    // Velocity Verlet's dissipation, as VelocityVerlet::step counts it.
+    power_ = evaluation.viscous_power;
+    accountStep(start, evaluation.shear_force, end_stage_position, power_ * dt_);
+  }
+  if (steps > 1) std::swap(evaluation_, later_evaluations_[steps - 2]);
+  if (!group.last_concluded) concludeStep(group.starts[steps - 1]);
 }
 
 void Simulation::run() {

@@ -70,10 +70,9 @@ int run(int argc, char** argv) {
   double next_sample = sample_interval;
   friction::LoadCellReading before = loading.front();
   while (!simulation.finished()) {
-    // Two plain steps at once where no loading-curve sample falls in them: the samples stay those of
-    // single steps.
-    const double dt = simulation.timeStep();
-    simulation.advance(scene.stop.time, (simulation.time() + dt) + dt < next_sample);
+    // Several plain steps at once where they all end before the next loading-curve sample: the samples
+    // stay those of single steps.
+    simulation.advance(scene.stop.time, next_sample);
     const friction::LoadCellReading after = simulation.loadCells();
     for (; next_sample <= after.time; next_sample += sample_interval) {
       loading.push_back(friction::interpolate(before, after, next_sample));
