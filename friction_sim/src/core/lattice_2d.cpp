@@ -168,8 +168,7 @@ class Lattice2D::Sweep {
     const int nx = l.nx_, nz = l.nz_, n = l.n_, j = row_;
     const int prepared_end = preparedRowsForNextRow();
     if (prepared_end > prepared_rows_) {
-      evaluation_.hooks.prepare(prepared_rows_ * nx, prepared_end * nx);
-      evaluation_.hooks.prepare(n + prepared_rows_ * nx, n + prepared_end * nx);
+      forBothComponents(prepared_rows_, prepared_end, &StripHooks::prepare);
       prepared_rows_ = prepared_end;
     }
     double* fx = evaluation_.force.data();
@@ -228,8 +227,7 @@ class Lattice2D::Sweep {
       shear_ += pusher_force;
     }
     if (j + 1 - finished_rows_ >= rows_per_strip_ || j == nz - 1) {
-      evaluation_.hooks.finish(finished_rows_ * nx, (j + 1) * nx);
-      evaluation_.hooks.finish(n + finished_rows_ * nx, n + (j + 1) * nx);
+      forBothComponents(finished_rows_, j + 1, &StripHooks::finish);
       finished_rows_ = j + 1;
     }
     ++row_;
@@ -243,6 +241,13 @@ class Lattice2D::Sweep {
   }
 
  private:
+  /// Calls `hook` on rows [first_row, end_row): their x, then their z degrees of freedom.
+  void forBothComponents(int first_row, int end_row, void (StripHooks::*hook)(int, int)) {
+    const int nx = lattice_.nx_, n = lattice_.n_;
+    (evaluation_.hooks.*hook)(first_row * nx, end_row * nx);
+    (evaluation_.hooks.*hook)(n + first_row * nx, n + end_row * nx);
+  }
+
   void run(const BondFamily& family, int a0, int b0, int count, double* out_x, double* out_z) {
     bonds_(nodes_, a0, b0, count, family.ex * family.rest_length, family.ez * family.rest_length, family.rest_length,
            family.stiffness, lattice_.eta_, out_x, out_z, space_.column_power.data());

@@ -390,9 +390,9 @@ void Simulation::stepInGroup(double group_before) {
     if (k > 0) start.shear_force = groupEvaluation(k - 1).shear_force;
     const double end_stage_position = k + 1 < steps ? group.starts[k + 1].stage_position : stage_.position();
     // Velocity Verlet's dissipation, as VelocityVerlet::step counts it.
-    power_ = evaluation.viscous_power;
-    accountStep(start, evaluation.shear_force, end_stage_position, power_ * dt_);
+    accountStep(start, evaluation.shear_force, end_stage_position, evaluation.viscous_power * dt_);
   }
+  power_ = groupEvaluation(steps - 1).viscous_power;
   if (steps > 1) std::swap(evaluation_, later_evaluations_[steps - 2]);
   if (!group.last_concluded) concludeStep(group.starts[steps - 1]);
 }
