@@ -114,12 +114,40 @@ TEST_F(OneNode, ReSticksAtTheInterpolatedZeroCrossingOfTheVelocity) {
   EXPECT_DOUBLE_EQ(v_[0], 0.0);
 }
 
-TEST_F(OneNode, CannotReStickInTheStepRightAfterUnsticking) {
+TEST_F(OneNode, CannotReStickInTheStepRightAfterUnstickingButTurnsWithItsVelocity) {
+  update(4.1, 10.0);  // unsticks towards +x
+  contact_.beginStep(u_, v_);
+  v_[0] = -1e-3;
+  EXPECT_TRUE(contact_.finishStep(u_, v_, 1e-3));  // its friction changed
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  // Sliding towards −x now: kinetic friction along +x.
+  EXPECT_DOUBLE_EQ(net(1.0, 10.0), 1.0 + kMuK * 10.0);
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), kMuK * 10.0);
+}
+
+TEST_F(OneNode, NodeThatTurnedAfterUnstickingReSticksWhenItsVelocityPassesThroughZeroAgain) {
+  const double dt = 1e-3;
   update(4.1, 10.0);
   contact_.beginStep(u_, v_);
   v_[0] = -1e-3;
-  EXPECT_FALSE(contact_.finishStep(u_, v_, 1e-3));
-  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  u_[0] = -0.5e-3 * dt;
+  ASSERT_TRUE(contact_.finishStep(u_, v_, dt));
+  // Its friction changed, so the forces are evaluated again; a constant +2 N pulls it back: net 2 + 1.7 N
+  // on 1 kg, from −1 mm/s through zero within the next step (after 1e-3 / 3.7 s = 0.27 dt).
+  const double acceleration = net(2.0, 10.0);
+  const double start_u = u_[0];
+  const double dissipated_before = contact_.frictionDissipation();
+  contact_.beginStep(u_, v_);
+  EXPECT_DOUBLE_EQ(acceleration, 2.0 + kMuK * 10.0);
+  v_[0] += acceleration * dt;
+  u_[0] += (-1e-3 + 0.5 * acceleration * dt) * dt;
+  EXPECT_TRUE(contact_.finishStep(u_, v_, dt));
+  EXPECT_EQ(contact_.state(0), ContactState::Stuck);
+  const double fraction = 1e-3 / (acceleration * dt);
+  EXPECT_NEAR(contact_.transitionFraction(0), fraction, 1e-12);
+  EXPECT_NEAR(u_[0], start_u - 0.5e-3 * fraction * dt, 1e-15);
+  // Friction opposed the motion: it dissipated µ_k·N times the distance slid.
+  EXPECT_NEAR(contact_.frictionDissipation() - dissipated_before, kMuK * 10.0 * 0.5e-3 * fraction * dt, 1e-15);
 }
 
 TEST_F(OneNode, LosesContactAtZeroNormalForceAndRecovers) {

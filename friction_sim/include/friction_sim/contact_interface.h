@@ -55,7 +55,9 @@ class ContactInterface {
   /// Remembers the interface at the start of a step.
   void beginStep(const Vector& u, const Vector& v);
   /// After the integrator's step: stops nodes whose velocity passed through zero at the interpolated
-  /// crossing, accounts friction dissipation and slip. Returns true if any node re-stuck.
+  /// crossing, accounts friction dissipation and slip. A node in the step right after it unstuck may not
+  /// re-stick; if its velocity turned in that step, it slides the other way from then on. Returns true if
+  /// any node's friction changed (it re-stuck or turned).
   bool finishStep(Vector& u, Vector& v, double dt);
   /// After the last force evaluation of a step of length dt and its applyFriction at these displacements
   /// (the stuck nodes' loads are its friction forces): loss and return of

@@ -176,7 +176,7 @@ void ContactInterface::beginStep(const Vector& u, const Vector& v) {
 }
 
 bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
-  bool restuck = false;
+  bool changed = false;
   if (sliding_count_ > 0) {
     for (int node = 0; node < size(); ++node) {
       // Re-sticking below changes only this node, so state_ still holds the step's start here.
@@ -185,9 +185,17 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
       const double direction = friction_mode_[node];  // ±1: it slides
       const double v_start = start_v_[node] * direction;
       const double v_end = v[dof] * direction;
-      if (!just_unstuck_[node] && v_start > 0.0 && v_end <= 0.0) {
+      if (just_unstuck_[node]) {
+        // It may not re-stick in this step, but friction must oppose its velocity (f = −µ·N·sgn v): had it
+        // kept its direction while moving the other way, its velocity would never pass through zero in
+        // that direction again, and friction would drive it on.
+        if (v_end < 0.0) {
+          friction_mode_[node] = -direction;
+          changed = true;
+        }
+      } else if (v_start >= 0.0 && v_end <= 0.0) {
         // Velocity is close to linear in time over one step: stop where it crosses zero.
-        const double fraction = v_start / (v_start - v_end);
+        const double fraction = v_start > 0.0 ? v_start / (v_start - v_end) : 0.0;
         u[dof] = start_u_[node] + 0.5 * start_v_[node] * fraction * dt;
         v[dof] = 0.0;
         setState(node, ContactState::Stuck);
@@ -202,7 +210,7 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
         } else {
           anchor_[node] = u[dof];
         }
-        restuck = true;
+        changed = true;
       }
       const double slip = u[dof] - start_u_[node];
       dissipation_ -= start_friction_[node] * slip;
@@ -211,7 +219,7 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
     }
   }
   for (int node : unstuck_last_step_) just_unstuck_[node] = 0;  // the only nodes flagged
-  return restuck;
+  return changed;
 }
 
 void ContactInterface::stick(int node, const Vector& u) {
