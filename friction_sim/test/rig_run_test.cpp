@@ -15,10 +15,12 @@
 #include <friction_msgs/StrainGaugeProfile.h>
 #include <geometry_msgs/WrenchStamped.h>
 #include <gtest/gtest.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <rosgraph_msgs/Clock.h>
+#include <std_srvs/Trigger.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -46,8 +48,9 @@ struct Observed {
   std::map<std::string, std::string> topic_types;
   std::vector<friction_msgs::SendStageCommand::Response> bad_command_replies;
   double time_after_bad_commands = 0.0;
-  std::string bad_scene_output, bad_parameter_output;
-  int bad_scene_status = 0, bad_parameter_status = 0;
+  std::string bad_scene_output, bad_parameter_output, bad_protocol_output;
+  int bad_scene_status = 0, bad_parameter_status = 0, bad_protocol_status = 0;
+  int stops_after_bad_protocol = 0;
 };
 Observed g_seen;
 std::string g_bag;
@@ -74,6 +77,31 @@ bool waitFor(const std::function<bool()>& condition, double seconds) {
 template <class Message, class Callback>
 ros::Subscriber listen(ros::NodeHandle& nh, const std::string& topic, Callback callback) {
   return nh.subscribe<Message>(topic, 10000, boost::function<void(const typename Message::ConstPtr&)>(callback));
+}
+
+/// A controller given a bad protocol, in a namespace of its own whose simulator is a stop service that
+/// counts its calls (answered on a queue of its own while the controller runs).
+void runRefusedProtocol() {
+  const std::string protocol = "/tmp/friction_rig_bad_protocol.yaml";
+  std::FILE* file = std::fopen(protocol.c_str(), "w");
+  std::fputs("steps:\n  - {action: drive, speed: .nan, duration: -1.0}\nend: {global_events: 1}\n", file);
+  std::fclose(file);
+  ros::CallbackQueue queue;
+  ros::NodeHandle nh("/refused_protocol");
+  nh.setCallbackQueue(&queue);
+  const boost::function<bool(std_srvs::Trigger::Request&, std_srvs::Trigger::Response&)> count_stops =
+      [](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+        ++g_seen.stops_after_bad_protocol;
+        response.success = true;
+        return true;
+      };
+  ros::ServiceServer stop = nh.advertiseService("stop", count_stops);
+  ros::AsyncSpinner spinner(1, &queue);
+  spinner.start();
+  g_seen.bad_protocol_status = runCommand(
+      "rosrun friction_sim stage_controller __name:=controller __ns:=/refused_protocol _protocol:=" + protocol,
+      g_seen.bad_protocol_output);
+  spinner.stop();
 }
 
 bool bagReadable(const std::string& path) {
@@ -192,6 +220,12 @@ TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
   EXPECT_EQ(g_seen.bad_parameter_status, 2);
   EXPECT_NE(g_seen.bad_parameter_output.find("~load_cell_rate: value -1"), std::string::npos)
       << g_seen.bad_parameter_output;
+  // A refused protocol lists every problem, and the controller ends the run of the simulator that waits
+  // for it rather than leave it waiting.
+  EXPECT_EQ(g_seen.bad_protocol_status, 2);
+  EXPECT_NE(g_seen.bad_protocol_output.find("protocol refused (2 problems)"), std::string::npos)
+      << g_seen.bad_protocol_output;
+  EXPECT_EQ(g_seen.stops_after_bad_protocol, 1);
 }
 
 TEST(FullRun, BagHoldsEverySlipEventAndEveryInterfaceFrame) {
@@ -292,6 +326,7 @@ void watchFullRun(ros::NodeHandle& nh) {
   g_seen.bad_parameter_status = runCommand(
       "rosrun friction_sim rig_simulator __name:=bad_parameter _load_cell_rate:=-1.0 _scene:=" + scene,
       g_seen.bad_parameter_output);
+  runRefusedProtocol();
   // The controller ends the run after two global events; the simulator then closes its bag.
   waitFor([] { return bagReadable(g_bag); }, 240.0);
   waitFor([] { return g_seen.live_points.size() >= g_seen.events.size(); }, 10.0);

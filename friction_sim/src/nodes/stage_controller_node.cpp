@@ -20,6 +20,9 @@ int main(int argc, char** argv) {
     ros::spin();
   } catch (const friction::ConfigError& error) {
     std::cerr << error.what() << std::endl;
+    // A simulator started paused waits for this node's protocol: end its run rather than leave it waiting.
+    ros::NodeHandle nh;
+    friction::stopSimulator(nh, ros::WallDuration(10.0));
     return 2;
   }
   return 0;

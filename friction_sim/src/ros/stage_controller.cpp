@@ -8,11 +8,16 @@
 
 namespace friction {
 
+bool stopSimulator(ros::NodeHandle& nh, ros::WallDuration wait) {
+  ros::ServiceClient client = nh.serviceClient<std_srvs::Trigger>("stop");
+  std_srvs::Trigger stop;
+  return client.waitForExistence(ros::Duration(wait.toSec())) && client.call(stop);
+}
+
 StageController::StageController(ros::NodeHandle nh, LoadingProtocol protocol, double start_delay)
     : nh_(std::move(nh)), protocol_(std::move(protocol)), start_delay_(start_delay) {
   command_client_ = nh_.serviceClient<friction_msgs::SendStageCommand>("send_command");
   pause_client_ = nh_.serviceClient<std_srvs::SetBool>("pause");
-  stop_client_ = nh_.serviceClient<std_srvs::Trigger>("stop");
   state_sub_ = nh_.subscribe("stage_state", 100, &StageController::onStageState, this);
 }
 
@@ -50,8 +55,7 @@ void StageController::onStageState(const friction_msgs::StageState::ConstPtr& ms
   ended_ = true;
   ROS_INFO_STREAM("stage controller: protocol ended at t = " << time << " s after " << msg->global_events
                                                              << " global events; stopping the simulator");
-  std_srvs::Trigger stop;
-  stop_client_.call(stop);
+  stopSimulator(nh_, ros::WallDuration(5.0));
   ros::shutdown();
 }
 

@@ -11,7 +11,9 @@
 //   send_command (friction_msgs/SendStageCommand)  every scheduled command, stamped with its time
 //   pause (std_srvs/SetBool)                        called with false once the schedule is sent, so
 //                                                   that a simulator started paused runs every command on time
-//   stop (std_srvs/Trigger)                        once an end condition of the protocol holds
+//   stop (std_srvs/Trigger)                        once an end condition of the protocol holds, or when
+//                                                   the protocol or a parameter is refused (the node then
+//                                                   exits with status 2, the problems listed on stderr)
 //
 // Uses ROS time only (the stage state's stamps, i.e. simulated time). If time jumps backwards (a reset
 // or looped playback), it starts the protocol again from the new time.
@@ -23,6 +25,10 @@
 #include "friction_sim/loading_protocol.h"
 
 namespace friction {
+
+/// Asks the simulator in `nh`'s namespace to end its run, waiting up to `wait` for its stop service;
+/// false if the service did not appear or the call failed.
+bool stopSimulator(ros::NodeHandle& nh, ros::WallDuration wait);
 
 class StageController {
  public:
@@ -36,7 +42,7 @@ class StageController {
   LoadingProtocol protocol_;
   double start_delay_;
   ros::Subscriber state_sub_;
-  ros::ServiceClient command_client_, pause_client_, stop_client_;
+  ros::ServiceClient command_client_, pause_client_;
   bool started_ = false;
   bool ended_ = false;
   double start_time_ = 0.0;
