@@ -102,22 +102,43 @@ TEST(Conversions, CommandsRoundTripWithTheirTime) {
 }
 
 TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
-  const Stage stage(StageSpec{}, 1e-7);
+  Scene scene;
+  scene.model = ModelKind::Chain1D;
+  scene.chain.blocks = 3;
+  const Simulation simulation(scene);
   friction_msgs::StageCommand msg;
   msg.mode = friction_msgs::StageCommand::VELOCITY;
   msg.speed = std::nan("");
-  EXPECT_NE(checkCommand(msg, stage).find("finite"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, simulation).find("finite"), std::string::npos);
   msg.speed = 2.0;
-  EXPECT_NE(checkCommand(msg, stage).find("max_speed"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, simulation).find("max_speed"), std::string::npos);
   msg.speed = 4e-4;
-  EXPECT_EQ(checkCommand(msg, stage), "");
+  EXPECT_EQ(checkCommand(msg, simulation), "");
   msg.mode = friction_msgs::StageCommand::NORMAL_LOAD;
+  msg.normal_force = 2500.0;
+  EXPECT_EQ(checkCommand(msg, simulation), "");
   msg.normal_force = -10.0;
-  EXPECT_NE(checkCommand(msg, stage).find("normal load -10 N"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, simulation).find("normal load -10 N"), std::string::npos);
   msg.normal_force = std::numeric_limits<double>::infinity();
-  EXPECT_NE(checkCommand(msg, stage).find("finite F_Z"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, simulation).find("finite F_Z"), std::string::npos);
   msg.mode = 9;
-  EXPECT_NE(checkCommand(msg, stage).find("mode 9 is unknown"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, simulation).find("mode 9 is unknown"), std::string::npos);
+}
+
+TEST(CommandChecks, NormalLoadChangesAreRefusedWithTheSpringMattress) {
+  Scene scene;
+  scene.lattice.nodes_x = 29;  // square cells of 5 mm in the default 140 × 75 mm slider
+  scene.lattice.nodes_z = 16;
+  scene.load.top = TopLoadKind::SpringMattress;
+  Simulation simulation(scene);
+  friction_msgs::StageCommand msg;
+  msg.mode = friction_msgs::StageCommand::NORMAL_LOAD;
+  msg.normal_force = 2500.0;
+  EXPECT_NE(checkCommand(msg, simulation).find("spring_mattress"), std::string::npos) << checkCommand(msg, simulation);
+  // Refused where it would be applied too, with the load unchanged.
+  const double load = simulation.loadCells().normal_force;
+  EXPECT_NE(simulation.setNormalLoad(2500.0), "");
+  EXPECT_EQ(simulation.loadCells().normal_force, load);
 }
 
 TEST(SimulatorOptions, EveryBadParameterIsNamedWithValueAndRange) {

@@ -79,8 +79,11 @@ class Simulation : public Dynamics {
   /// Stage commands from a controller replace the scene's stage program.
   Stage& stage() { return stage_; }
   const Stage& stage() const { return stage_; }
-  /// N, changes F_Z during the run; returns the refusal reason or empty.
+  /// N, changes F_Z during the run; returns the refusal reason (checkNormalLoad) or empty.
   std::string setNormalLoad(double normal_force);
+  /// Why F_Z = `normal_force` (N) cannot be set now (empty if it can): it must be finite and > 0, and
+  /// the spring mattress's plate is placed once, when F_Z is first applied.
+  std::string checkNormalLoad(double normal_force) const;
 
   const Scene& scene() const { return scene_; }
   const Model& model() const { return *model_; }

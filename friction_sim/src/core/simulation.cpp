@@ -420,12 +420,23 @@ void Simulation::checkStop() {
   stop_reason_ = reason.str();
 }
 
-std::string Simulation::setNormalLoad(double normal_force) {
+std::string Simulation::checkNormalLoad(double normal_force) const {
+  std::ostringstream reason;
   if (!std::isfinite(normal_force) || normal_force <= 0.0) {
-    std::ostringstream reason;
-    reason << "normal load " << normal_force << " N must be finite and > 0";
-    return reason.str();
+    reason << "normal load " << normal_force << " N is not allowed; allowed: a finite F_Z > 0 N";
+  } else if (scene_.model == ModelKind::Lattice2D && scene_.load.top == TopLoadKind::SpringMattress) {
+    // Moving the plate by ΔF_Z/(N_x·k_m) would not do: the slider yields under it, and the springs end up
+    // carrying a fraction of the change (in a 29 × 16 slider, 49 N of 580 N asked).
+    reason << "normal load " << normal_force
+           << " N refused: F_Z cannot change during a run with load.top spring_mattress (its plate is placed "
+              "once, when F_Z is applied); use load.top uniform";
   }
+  return reason.str();
+}
+
+std::string Simulation::setNormalLoad(double normal_force) {
+  std::string reason = checkNormalLoad(normal_force);
+  if (!reason.empty()) return reason;
   external_work_closed_ += model_->externalWork(external_reference_u_, u_);
   external_reference_u_ = u_;
   model_->setNormalLoad(normal_force);

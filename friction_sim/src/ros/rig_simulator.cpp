@@ -96,18 +96,13 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   return o;
 }
 
-std::string checkCommand(const friction_msgs::StageCommand& msg, const Stage& stage) {
-  std::ostringstream reason;
+std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulation& simulation) {
   if (msg.mode > friction_msgs::StageCommand::NORMAL_LOAD) {
-    reason << "mode " << static_cast<int>(msg.mode) << " is unknown; allowed: 0 VELOCITY, 1 HOLD, 2 POSITION, 3 NORMAL_LOAD";
-  } else if (msg.mode == friction_msgs::StageCommand::NORMAL_LOAD) {
-    if (!std::isfinite(msg.normal_force) || msg.normal_force <= 0.0) {
-      reason << "normal load " << msg.normal_force << " N is not allowed; allowed: a finite F_Z > 0 N";
-    }
-  } else if (msg.mode != friction_msgs::StageCommand::HOLD) {
-    return stage.checkCommand(fromMsg(msg).stage);
+    return "mode " + std::to_string(msg.mode) + " is unknown; allowed: 0 VELOCITY, 1 HOLD, 2 POSITION, 3 NORMAL_LOAD";
   }
-  return reason.str();
+  if (msg.mode == friction_msgs::StageCommand::NORMAL_LOAD) return simulation.checkNormalLoad(msg.normal_force);
+  if (msg.mode == friction_msgs::StageCommand::HOLD) return {};
+  return simulation.stage().checkCommand(fromMsg(msg).stage);
 }
 
 RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
@@ -238,7 +233,7 @@ void RigSimulator::publishInstruments(bool event_boundary) {
 }
 
 std::string RigSimulator::accept(const friction_msgs::StageCommand& msg) {
-  std::string reason = checkCommand(msg, simulation_->stage());
+  std::string reason = checkCommand(msg, *simulation_);
   if (!reason.empty()) {
     ROS_WARN_STREAM("stage command refused: " << reason);
     return reason;

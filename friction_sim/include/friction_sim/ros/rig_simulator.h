@@ -81,7 +81,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& private_nh);
 std::vector<std::pair<std::string, std::string>> parseOverrides(const std::string& text,
                                                                 std::vector<std::string>& problems);
 /// Why a command must be refused (empty = acceptable).
-std::string checkCommand(const friction_msgs::StageCommand& msg, const Stage& stage);
+std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulation& simulation);
 
 /// Set by SIGINT/SIGTERM: the node finishes its bag and exits.
 extern std::atomic<bool> g_stop_requested;
