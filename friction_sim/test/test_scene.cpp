@@ -91,7 +91,10 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"stage: {program: [{mode: velocity, speed: 5.0}]}", "stage.program[0].speed: value 5",
                     "stage.max_speed"},
         InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [1.0, 2.0]}",
-                    "chain.initial_shear (length): value 2", "one force per block"}));
+                    "chain.initial_shear (length): value 2", "one force per block"},
+        InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [3.0, 2.0, 1.0]}\n"
+                    "friction: {interfacial_stiffness: 1.0e8}",
+                    "friction.interfacial_stiffness: value 100000000", "0 (rigid sticking) with a chain.initial_shear"}));
 
 TEST(InvalidScene, UnstableTimeStepMessageGivesTheLimit) {
   const auto problems = problemsOf("integrator: {time_step: 1.0e-5}");

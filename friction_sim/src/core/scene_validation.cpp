@@ -85,6 +85,9 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
         check.require(std::isfinite(s.chain.initial_shear[i]), "chain.initial_shear[" + std::to_string(i) + "]",
                       s.chain.initial_shear[i], "a finite force in N");
       }
+      // Elastic anchors start unstretched, holding nothing: the prescribed shear would be lost at once.
+      check.require(s.friction.interfacial_stiffness == 0.0, "friction.interfacial_stiffness",
+                    s.friction.interfacial_stiffness, "0 (rigid sticking) with a chain.initial_shear profile");
     }
   }
 
