@@ -143,6 +143,8 @@ class Model {
 
   /// N, sets the normal load F_Z.
   virtual void setNormalLoad(double normal_force) = 0;
+  /// Whether F_Z may change during a run (setNormalLoad then acts at once).
+  virtual bool takesNormalLoadChanges() const { return true; }
 
   /// Strain-gauge stresses at height z (m) above the interface at positions x (m).
   virtual GaugeStresses gaugeStresses(const Vector& u, double height,

@@ -424,9 +424,7 @@ std::string Simulation::checkNormalLoad(double normal_force) const {
   std::ostringstream reason;
   if (!std::isfinite(normal_force) || normal_force <= 0.0) {
     reason << "normal load " << normal_force << " N is not allowed; allowed: a finite F_Z > 0 N";
-  } else if (scene_.model == ModelKind::Lattice2D && scene_.load.top == TopLoadKind::SpringMattress) {
-    // Moving the plate by ΔF_Z/(N_x·k_m) would not do: the slider yields under it, and the springs end up
-    // carrying a fraction of the change (in a 29 × 16 slider, 49 N of 580 N asked).
+  } else if (!model_->takesNormalLoadChanges()) {
     reason << "normal load " << normal_force
            << " N refused: F_Z cannot change during a run with load.top spring_mattress (its plate is placed "
               "once, when F_Z is applied); use load.top uniform";
