@@ -84,6 +84,9 @@ INSTANTIATE_TEST_SUITE_P(
                     "stability limit of this scene"},
         InvalidCase{"model: chain_1d\nchain: {tilt: -1.5}", "normal force of block", "w_i > 0"},
         InvalidCase{"model: chain_1d\nchain: {torque_share: 1.0}\npusher: {height: 0.075}", "at F_X = 768 N", "w_i > 0"},
+        // Holds while the stage pushes; the trailing-edge-heavy tilt lifts the leading block once it pulls.
+        InvalidCase{"model: chain_1d\nchain: {tilt: -0.8, torque_share: 1.0}\npusher: {height: 0.03}",
+                    "at F_X = -768 N", "F_X in [-768, 768] N, the stage pushing or pulling"},
         InvalidCase{"frictoin: {law: amontons_coulomb}", "frictoin: unknown key", "allowed keys here"},
         InvalidCase{"friction: {mu_s: 0.4}", "friction.mu_s: unknown key", "static_coefficient"},
         InvalidCase{"friction: {law: coulomb}", "friction.law: value 'coulomb'", "amontons_coulomb | slip_weakening"},

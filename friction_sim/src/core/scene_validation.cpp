@@ -153,16 +153,18 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
   if (!model_valid) return check.problems;
   if (!lattice && check.clean({"friction.static_coefficient"})) {
     const Chain1D chain(s);
-    // F_X stays between 0 and the interface's total static friction µ_s·F_Z; w_i is linear in F_X.
+    // |F_X| stays below the interface's total static friction µ_s·F_Z, in either direction: the stage
+    // program or the controller may drive the stage back. w_i is linear in F_X, so the ends suffice.
+    const double most_shear = mu_s * s.load.normal_force;
     bool reported = false;
-    for (double shear : {0.0, mu_s * s.load.normal_force}) {
+    for (double shear : {0.0, most_shear, -most_shear}) {
       const std::vector<double> w = chain.normalForces(shear);
       for (std::size_t i = 0; i < w.size() && !reported; ++i) {
         if (w[i] > 0.0) continue;
         std::ostringstream text;
         text << "chain.tilt/chain.torque_share: the normal force of block " << i << " would be " << w[i]
-             << " N at F_X = " << shear << " N; allowed: every block's normal force w_i > 0 for F_X in [0, "
-             << mu_s * s.load.normal_force << "] N (reduce tilt, torque_share or pusher.height)";
+             << " N at F_X = " << shear << " N; allowed: every block's normal force w_i > 0 for F_X in [" << -most_shear
+             << ", " << most_shear << "] N, the stage pushing or pulling (reduce tilt, torque_share or pusher.height)";
         check.problems.push_back(text.str());
         reported = true;
       }
