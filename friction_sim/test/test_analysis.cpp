@@ -59,6 +59,39 @@ TEST(LoadingProtocol, BadProtocolListsEveryProblem) {
   }
 }
 
+TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
+  // Nodes 0–2 (2.5 mm apart) unstick together; a front then runs at 600 m/s up to node 10; node 11 holds.
+  const double spacing = 0.0025, speed = 600.0;
+  std::vector<double> positions, first_unstick;
+  for (int node = 0; node < 12; ++node) {
+    positions.push_back(node * spacing);
+    first_unstick.push_back(node <= 2 ? 0.0 : (node - 2) * spacing / speed);
+  }
+  first_unstick[11] = std::nan("");
+  const std::vector<double> v_c = frontSpeeds(positions, first_unstick, 5);
+  // A five-node fit is exact where all five lie on the front; the patch's fits are apparent speeds.
+  EXPECT_TRUE(std::isinf(v_c[0]));
+  EXPECT_NEAR(v_c[1], 2000.0, 1e-9);
+  EXPECT_NEAR(v_c[2], 1200.0, 1e-9);
+  EXPECT_NEAR(v_c[3], 750.0, 1e-9);
+  for (int node = 4; node <= 10; ++node) EXPECT_NEAR(v_c[node], speed, 1e-9) << "node " << node;
+  EXPECT_TRUE(std::isnan(v_c[11]));
+
+  Scene scene;  // pmma_2d: c_L = 1677 m/s
+  const WaveSpeeds c = waveSpeeds(scene);
+  EXPECT_NEAR(c.longitudinal, 1677.05, 0.01);
+  EXPECT_NEAR(c.rayleigh / c.shear, 0.919, 1e-12);
+  const FrontSpeedSummary summary = summarizeFrontSpeeds(v_c, c.longitudinal);
+  EXPECT_EQ(summary.faster_than_longitudinal, 2);  // inf and 2000 m/s
+  EXPECT_NEAR(summary.median, speed, 1e-9);
+
+  // All together: no front ran, so no median.
+  const FrontSpeedSummary together = summarizeFrontSpeeds(frontSpeeds(positions, std::vector<double>(12, 0.0), 5),
+                                                          c.longitudinal);
+  EXPECT_EQ(together.faster_than_longitudinal, 12);
+  EXPECT_TRUE(std::isnan(together.median));
+}
+
 TEST(FrameEventDetector, FindsTheSimulatorsEventsFromTheInstrumentsAlone) {
   // Frames as the simulator node publishes them: every 50 steps during events, every 0.01 s while
   // stuck, and at every step where an event starts or ends; load cells every 1e-4 s and at those steps.

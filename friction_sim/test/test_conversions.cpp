@@ -65,10 +65,12 @@ TEST(Conversions, SlipEventCarriesEveryQuantity) {
   event.node_slip = {1e-6, 5e-7, 0.0};
   event.first_unstick_time = {0.1, 0.10001, std::nan("")};
   event.front_speed = {250.0, 250.0, std::nan("")};
-  const auto msg = toMsg(event, {0.0, 0.0025, 0.005}, 0.14, WaveSpeeds{890.0, 968.0}, "slider");
+  const auto msg = toMsg(event, {0.0, 0.0025, 0.005}, 0.14, WaveSpeeds{1677.0, 968.0, 890.0}, "slider");
   EXPECT_EQ(msg.header.stamp, ros::Time(0.1004));
   EXPECT_DOUBLE_EQ(msg.slider_length, 0.14);
   EXPECT_DOUBLE_EQ(msg.rayleigh_speed, 890.0);
+  EXPECT_DOUBLE_EQ(msg.shear_wave_speed, 968.0);
+  EXPECT_DOUBLE_EQ(msg.longitudinal_wave_speed, 1677.0);
   const SlipEvent back = fromMsg(msg);
   EXPECT_EQ(back.index, 3);
   EXPECT_DOUBLE_EQ(back.onset_shear_force, 200.0);

@@ -9,6 +9,7 @@
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/lattice_2d.h"
+#include "friction_sim/slip_events.h"
 #include "test_helpers.h"
 
 namespace friction {
@@ -129,8 +130,9 @@ TEST(LatticeWaves, PAndSWaveSpeedsFromArrivalTimes) {
     }
   }
   double power = body.acceleration(u, v, 0.0, a);
-  const double E = scene.material.youngs_modulus, rho = scene.material.density, nu = 1.0 / 3.0;
-  const double c_l = std::sqrt(E / (rho * (1 - nu * nu))), c_s = std::sqrt(3.0 * E / 8.0 / rho);
+  // The speeds that front speeds are expressed in: plane stress, ν = 1/3.
+  const WaveSpeeds speeds = waveSpeeds(scene);
+  const double c_l = speeds.longitudinal, c_s = speeds.shear;
   const int near = 12, far = 30;
   const int receivers[4] = {lattice.nodeIndex(centre + near, centre), lattice.nodeIndex(centre + far, centre),
                             lattice.nodeIndex(centre, centre + near), lattice.nodeIndex(centre, centre + far)};

@@ -6,6 +6,7 @@
 
 #include "friction_sim/contact_interface.h"
 #include "friction_sim/model.h"
+#include "friction_sim/scene.h"
 
 namespace friction {
 
@@ -61,5 +62,25 @@ class SlipEventDetector {
 /// x over `fit_nodes` consecutive slipped nodes centred on each node; v_c = 1/|dt/dx| (inf if simultaneous).
 std::vector<double> frontSpeeds(const std::vector<double>& positions,
                                 const std::vector<double>& first_unstick_time, int fit_nodes);
+
+/// The model's elastic wave speeds, the scale of front speeds (MODEL.md §6).
+struct WaveSpeeds {
+  /// m/s, c_L of the lattice (plane stress, ν = 1/3) or the bar speed √(E/ρ) of the chain: nothing that
+  /// elastic waves carry outruns it
+  double longitudinal = 0.0;
+  double shear = 0.0;     ///< m/s, c_S of the lattice, or the chain's bar speed
+  double rayleigh = 0.0;  ///< m/s, c_R of the lattice; 0 for the chain, which has no surface wave
+};
+WaveSpeeds waveSpeeds(const Scene& scene);
+
+/// An event's front speed in one number.
+struct FrontSpeedSummary {
+  /// m/s, median v_c over the nodes whose fit is at most c_L; NaN if there are none
+  double median = 0.0;
+  /// nodes whose fit is faster than c_L (inf included): they unstuck too nearly together for a running
+  /// front, as where the pusher's load fails several nodes at once; left out of the median
+  int faster_than_longitudinal = 0;
+};
+FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed, double longitudinal_speed);
 
 }  // namespace friction

@@ -51,30 +51,22 @@ void printSummary(std::ostream& out, const RunSummary& s) {
       << "  energy-balance residual (relative): " << std::setprecision(3) << s.relative_energy_residual << "\n";
 }
 
-namespace {
-// The median is robust against the few nodes that unstick almost together at the ends of a front.
-double medianFinite(const std::vector<double>& values) {
-  std::vector<double> finite;
-  for (double value : values) {
-    if (std::isfinite(value)) finite.push_back(value);
-  }
-  if (finite.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::nth_element(finite.begin(), finite.begin() + finite.size() / 2, finite.end());
-  return finite[finite.size() / 2];
-}
-}  // namespace
-
-void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, double slider_length) {
+void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, const Scene& scene) {
   out << "index,onset_time_s,end_time_s,onset_shear_force_N,onset_normal_force_N,shear_ratio,"
          "end_shear_force_N,nucleation_x_m,slip_min_x_m,slip_max_x_m,rupture_length_m,length_ratio,global,"
-         "median_front_speed_m_s\n";
+         "median_front_speed_m_s,front_speed_over_c_s,front_speed_over_c_r,nodes_faster_than_c_l\n";
   out << std::setprecision(12);
+  const double slider_length = scene.geometry.length;
+  const WaveSpeeds speeds = waveSpeeds(scene);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const SlipEvent& e : events) {
+    const FrontSpeedSummary front = summarizeFrontSpeeds(e.front_speed, speeds.longitudinal);
     out << e.index << ',' << e.onset_time << ',' << e.end_time << ',' << e.onset_shear_force << ','
         << e.onset_normal_force << ',' << e.onset_shear_force / e.onset_normal_force << ',' << e.end_shear_force
         << ',' << e.nucleation_position << ',' << e.slip_min_x << ',' << e.slip_max_x << ',' << e.rupture_length
-        << ',' << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << medianFinite(e.front_speed)
-        << '\n';
+        << ',' << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << front.median << ','
+        << front.median / speeds.shear << ',' << (speeds.rayleigh > 0.0 ? front.median / speeds.rayleigh : nan)
+        << ',' << front.faster_than_longitudinal << '\n';
   }
 }
 

@@ -108,4 +108,39 @@ std::vector<double> frontSpeeds(const std::vector<double>& positions,
   return speed;
 }
 
+namespace {
+/// c_R/c_S for the lattice's ν = 1/3 (MODEL.md §2), the root of the Rayleigh equation.
+constexpr double kRayleighFraction = 0.919;
+}  // namespace
+
+WaveSpeeds waveSpeeds(const Scene& scene) {
+  const double E = scene.material.youngs_modulus, rho = scene.material.density;
+  if (scene.model == ModelKind::Chain1D) {
+    const double bar = std::sqrt(E / rho);
+    return {bar, bar, 0.0};
+  }
+  const double shear = std::sqrt(3.0 * E / 8.0 / rho);
+  return {std::sqrt(3.0) * shear, shear, kRayleighFraction * shear};
+}
+
+FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed, double longitudinal_speed) {
+  FrontSpeedSummary summary;
+  std::vector<double> running;
+  for (double speed : front_speed) {
+    if (std::isnan(speed)) continue;
+    if (speed <= longitudinal_speed) {
+      running.push_back(speed);
+    } else {
+      ++summary.faster_than_longitudinal;
+    }
+  }
+  if (running.empty()) {
+    summary.median = kNaN;
+  } else {
+    std::nth_element(running.begin(), running.begin() + running.size() / 2, running.end());
+    summary.median = running[running.size() / 2];
+  }
+  return summary;
+}
+
 }  // namespace friction

@@ -92,6 +92,7 @@ friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>
   msg.front_speed = event.front_speed;
   msg.rayleigh_speed = speeds.rayleigh;
   msg.shear_wave_speed = speeds.shear;
+  msg.longitudinal_wave_speed = speeds.longitudinal;
   return msg;
 }
 

@@ -15,16 +15,6 @@ std::atomic<bool> g_stop_requested{false};
 
 namespace {
 
-/// Rayleigh speed as a fraction of c_S for the lattice's ν = 1/3 (MODEL.md §2).
-constexpr double kRayleighFraction = 0.919;
-
-WaveSpeeds waveSpeedsOf(const Scene& scene) {
-  const double E = scene.material.youngs_modulus, rho = scene.material.density;
-  if (scene.model == ModelKind::Chain1D) return {0.0, std::sqrt(E / rho)};
-  const double shear = std::sqrt(3.0 * E / 8.0 / rho);
-  return {kRayleighFraction * shear, shear};
-}
-
 /// Advances a publication time past `now` on its regular grid; returns true if it was due.
 bool due(double now, double& next, double rate) {
   if (now < next) return false;
@@ -111,7 +101,7 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
   const auto overrides = parseOverrides(options_.overrides, problems);
   scene_ = loadScene(options_.scene_path, overrides, &stability_limit_);
   for (const std::string& warning : sceneWarnings(scene_)) ROS_WARN_STREAM("scene: " << warning);
-  wave_speeds_ = waveSpeedsOf(scene_);
+  wave_speeds_ = waveSpeeds(scene_);
   paused_ = options_.start_paused;
   startSimulation();
   if (!options_.bag_path.empty()) {

@@ -101,7 +101,7 @@ int run(int argc, char** argv) {
   std::ofstream events_csv(out_dir + "/events.csv"), nodes_csv(out_dir + "/event_nodes.csv"),
       loading_csv(out_dir + "/loading.csv"), scene_yaml(out_dir + "/scene.yaml"),
       summary_txt(out_dir + "/summary.txt");
-  friction::writeEventsCsv(events_csv, simulation.events(), scene.geometry.length);
+  friction::writeEventsCsv(events_csv, simulation.events(), scene);
   friction::writeEventNodesCsv(nodes_csv, simulation.events(), positions);
   friction::writeLoadingCsv(loading_csv, loading);
   scene_yaml << friction::sceneToYaml(scene);

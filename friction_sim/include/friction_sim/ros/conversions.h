@@ -34,11 +34,7 @@ InterfaceFrame fromMsg(const friction_msgs::InterfaceState& msg);
 
 friction_msgs::StrainGaugeProfile toMsg(const GaugeProfile& profile, const std::string& frame_id);
 
-/// Wave speeds of the model, carried by every event so that v_c/c_R can be formed downstream.
-struct WaveSpeeds {
-  double rayleigh = 0.0;  ///< m/s
-  double shear = 0.0;     ///< m/s
-};
+/// `speeds`: the model's, carried by every event so that v_c/c_R can be formed downstream.
 friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>& positions, double slider_length,
                                const WaveSpeeds& speeds, const std::string& frame_id);
 SlipEvent fromMsg(const friction_msgs::SlipEvent& msg);
