@@ -1,8 +1,8 @@
 // Slip events seen from the instruments alone (ROS-free core of the precursor detector node): the
 // interface camera's frames and the load cells, as an experimentalist has them. An event starts at a
 // frame with a sliding node after an all-stuck frame and ends at the next all-stuck frame; the slipped
-// nodes are those whose accumulated slip changed between the all-stuck frames around the event.
-// The simulator publishes a frame at every step where an event starts or ends, so none is missed.
+// nodes are those seen sliding in between. The simulator publishes a frame at every step where a node
+// unsticks and where an event ends, so the camera misses no node's slip and no event.
 #pragma once
 
 #include <deque>

@@ -95,7 +95,9 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   std::size_t slipped = 0;
   for (std::size_t node = 0; node < n; ++node) {
     event.node_slip[node] = frame.slip[node] - last_stuck_frame_->slip[node];
-    if (event.node_slip[node] == 0.0) continue;
+    // Seen sliding, not merely moved: with an interfacial stiffness stuck nodes move elastically, and
+    // detached nodes move freely.
+    if (std::isnan(event.first_unstick_time[node])) continue;
     ++slipped;
     x_min = std::min(x_min, frame.position[node]);
     x_max = std::max(x_max, frame.position[node]);

@@ -22,7 +22,7 @@
 //   /clock (rosgraph_msgs/Clock)                   simulated time
 //   load_cells (geometry_msgs/WrenchStamped)       F_X in force.x, F_Z in force.z
 //   strain_gauges (friction_msgs/StrainGaugeProfile)
-//   interface (friction_msgs/InterfaceState)       also at every step where an event starts or ends
+//   interface (friction_msgs/InterfaceState)       also at every step where a node unsticks or an event ends
 //   slip_events (friction_msgs/SlipEvent)          when an event ends
 //   lattice (friction_msgs/LatticeSnapshot)
 //   stage_state (friction_msgs/StageState)
@@ -97,7 +97,7 @@ class RigSimulator {
  private:
   void advertise();
   void startSimulation();
-  void publishInstruments(bool event_boundary);
+  void publishInstruments(bool event_boundary, bool node_unstuck);
   /// After a fast-forward jump: the load cells, gauges, stage state and clock at every publication time
   /// the jump passed, interpolated (the statics are affine in time along a jump).
   void publishAcrossJump(const LoadCellReading& cells_before, const GaugeProfile& gauges_before);
