@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "friction_sim/results_io.h"
 #include "friction_sim/simulation.h"
 #include "test_helpers.h"
 
@@ -43,6 +44,20 @@ TEST_F(SideDrivenChain, PrecursorsNucleateAtTheTrailingEdgeBeforeOneGlobalEvent)
     EXPECT_DOUBLE_EQ(event->slip_min_x, 0.0);
     EXPECT_GT(event->end_time, event->onset_time);
   }
+}
+
+TEST_F(SideDrivenChain, FirstPrecursorIsThePushedBlockAloneAtItsThreshold) {
+  // Uniform load: the pushed block carries F_Z/N and holds until F_X = µ_s·F_Z/N; no other block moves.
+  const Scene& scene = simulation_->scene();
+  const double threshold = scene.friction.static_coefficient * scene.load.normal_force / scene.chain.blocks;
+  const double one_step = scene.pusher.stiffness * scene.stage.program[0].speed * simulation_->timeStep();
+  const SlipEvent& first = *precursors().front();
+  EXPECT_NEAR(first.onset_shear_force, threshold, one_step);
+  EXPECT_EQ(first.rupture_length, 0.0);
+  EXPECT_EQ(first.node_slip[1], 0.0);
+  const RunSummary summary = summarize(*simulation_, 0.0);
+  EXPECT_EQ(summary.precursors, static_cast<int>(precursors().size()));
+  EXPECT_EQ(summary.single_node_precursors, 1);  // every later precursor runs a front
 }
 
 TEST_F(SideDrivenChain, ArrestFrontsFollowTheForceBalance) {

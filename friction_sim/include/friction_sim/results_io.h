@@ -22,6 +22,7 @@ struct RunSummary {
   std::string stop_reason;
   int events = 0;
   int precursors = 0;   ///< non-global events before the first global one
+  int single_node_precursors = 0;  ///< of those, events in which one node alone slipped (L_p = 0): no front ran
   std::vector<PrecursorPoint> precursor_points;
   double static_friction_macro = 0.0;  ///< µ_s,macro = F_X/F_Z at the first global event (NaN if none)
   double simulated_time = 0.0;         ///< s

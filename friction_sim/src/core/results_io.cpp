@@ -20,6 +20,7 @@ RunSummary summarize(const Simulation& simulation, double wall_time) {
       break;
     }
     ++summary.precursors;
+    if (event.rupture_length == 0.0) ++summary.single_node_precursors;
     summary.precursor_points.push_back(
         {event.onset_shear_force / event.onset_normal_force, event.rupture_length / scene.geometry.length});
   }
@@ -38,8 +39,9 @@ void printSummary(std::ostream& out, const RunSummary& s) {
       << " s (stability limit " << s.stability_limit << " s)\n"
       << "  wall time " << std::setprecision(3) << s.wall_time << " s, "
       << std::setprecision(4) << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
-      << "  slip events: " << s.events << ", precursors before the first global event: " << s.precursors
-      << "\n";
+      << "  slip events: " << s.events << ", precursors before the first global event: " << s.precursors;
+  if (s.single_node_precursors > 0) out << " (single-node slips, L_p = 0, among them: " << s.single_node_precursors << ")";
+  out << "\n";
   if (!s.precursor_points.empty()) {
     out << "  precursors (F_X/F_Z, L_p/L):";
     for (const PrecursorPoint& point : s.precursor_points) {
