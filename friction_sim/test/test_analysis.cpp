@@ -86,6 +86,14 @@ TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
   EXPECT_EQ(summary.faster_than_longitudinal, 2);  // inf and 2000 m/s
   EXPECT_NEAR(summary.median, speed, 1e-9);
 
+  // An even window is as long as asked: two nodes are the difference from the node behind.
+  const std::vector<double> pairs = frontSpeeds(positions, first_unstick, 2);
+  EXPECT_TRUE(std::isnan(pairs[0]));  // nothing behind it
+  EXPECT_TRUE(std::isinf(pairs[1]));
+  EXPECT_TRUE(std::isinf(pairs[2]));
+  for (int node = 3; node <= 10; ++node) EXPECT_NEAR(pairs[node], speed, 1e-9) << "node " << node;
+  EXPECT_TRUE(std::isnan(pairs[11]));
+
   // All together: no front ran, so no median.
   const FrontSpeedSummary together = summarizeFrontSpeeds(frontSpeeds(positions, std::vector<double>(12, 0.0), 5),
                                                           c.longitudinal);

@@ -59,7 +59,8 @@ class SlipEventDetector {
 };
 
 /// m/s, front speed per node from first-unstick times t(x) (NaN = not slipped): a linear fit of t against
-/// x over `fit_nodes` consecutive slipped nodes centred on each node; v_c = 1/|dt/dx| (inf if simultaneous).
+/// x over `fit_nodes` consecutive slipped nodes centred on each node (one more behind than ahead when
+/// even; fewer at the ends and at unslipped gaps); v_c = 1/|dt/dx| (inf if simultaneous).
 std::vector<double> frontSpeeds(const std::vector<double>& positions,
                                 const std::vector<double>& first_unstick_time, int fit_nodes);
 

@@ -83,13 +83,15 @@ std::vector<double> frontSpeeds(const std::vector<double>& positions,
                                 const std::vector<double>& first_unstick_time, int fit_nodes) {
   const int n = static_cast<int>(positions.size());
   std::vector<double> speed(n, kNaN);
-  const int half = std::max(fit_nodes, 2) / 2;
+  // A window of fit_nodes nodes: as many behind the centre as ahead, one more behind when even (the
+  // nodes the front has crossed, so that the last node before an arrest has a speed).
+  const int behind = std::max(fit_nodes, 2) / 2, ahead = (std::max(fit_nodes, 2) - 1) / 2;
   for (int centre = 0; centre < n; ++centre) {
     if (std::isnan(first_unstick_time[centre])) continue;
     // Fit over the slipped nodes of the window around the centre, not across unslipped gaps.
     int low = centre, high = centre;
-    while (low > 0 && centre - low < half && !std::isnan(first_unstick_time[low - 1])) --low;
-    while (high + 1 < n && high - centre < half && !std::isnan(first_unstick_time[high + 1])) ++high;
+    while (low > 0 && centre - low < behind && !std::isnan(first_unstick_time[low - 1])) --low;
+    while (high + 1 < n && high - centre < ahead && !std::isnan(first_unstick_time[high + 1])) ++high;
     if (high == low) continue;
     double mean_x = 0.0, mean_t = 0.0;
     const int count = high - low + 1;
