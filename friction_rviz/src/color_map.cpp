@@ -6,7 +6,7 @@
 
 namespace friction_rviz {
 
-Range autoRange(const std::vector<double>& values, bool symmetric) {
+Range autoRange(const std::vector<double>& values, bool signed_values) {
   double low = std::numeric_limits<double>::infinity(), high = -low;
   for (double value : values) {
     if (!std::isfinite(value)) continue;
@@ -14,23 +14,31 @@ Range autoRange(const std::vector<double>& values, bool symmetric) {
     high = std::max(high, value);
   }
   if (!(low <= high)) return Range{};
-  // Symmetric about zero only when the values change sign: an all-compressive σ_zz keeps its contrast.
-  if (symmetric && low < 0.0 && high > 0.0) {
+  Range range;
+  if (signed_values && low < 0.0 && high > 0.0) {
     const double extent = std::max(std::abs(low), std::abs(high));
     low = -extent;
     high = extent;
+  } else if (signed_values && high <= 0.0) {
+    // Short of white, which stands for zero stress: the slider stays visible on a white background.
+    range.map_to = 0.3;
+  } else if (signed_values) {
+    range.map_from = 0.7;
   }
   if (high - low <= 0.0) {
     const double pad = std::max(std::abs(high), 1.0) * 1e-6;
     low -= pad;
     high += pad;
   }
-  return Range{low, high};
+  range.min = low;
+  range.max = high;
+  return range;
 }
 
 Rgb colorOf(double value, const Range& range) {
   if (std::isnan(value)) return Rgb{0.5f, 0.5f, 0.5f};
-  const double s = std::clamp((value - range.min) / (range.max - range.min), 0.0, 1.0);
+  const double s = range.map_from + (range.map_to - range.map_from) *
+                                        std::clamp((value - range.min) / (range.max - range.min), 0.0, 1.0);
   // Blue (0.23, 0.30, 0.75) through white to red (0.71, 0.02, 0.15), linear in each half.
   const Rgb blue{0.23f, 0.30f, 0.75f}, white{0.95f, 0.95f, 0.95f}, red{0.71f, 0.02f, 0.15f};
   const Rgb& from = s < 0.5 ? blue : white;

@@ -26,9 +26,20 @@ TEST(ColorMap, AutomaticRangeIsSymmetricForSignedFields) {
   const Range symmetric = autoRange({-1.0, 3.0, std::nan("")}, true);
   EXPECT_DOUBLE_EQ(symmetric.min, -3.0);
   EXPECT_DOUBLE_EQ(symmetric.max, 3.0);
+  // All compressive: its own range, on the blue side from full blue to 60 % of the way to white.
   const Range one_signed = autoRange({-3.0, -1.0}, true);
   EXPECT_DOUBLE_EQ(one_signed.min, -3.0);
   EXPECT_DOUBLE_EQ(one_signed.max, -1.0);
+  const Rgb most = colorOf(-3.0, one_signed), least = colorOf(-1.0, one_signed), middle = colorOf(-2.0, one_signed);
+  EXPECT_FLOAT_EQ(most.r, 0.23f);
+  EXPECT_FLOAT_EQ(most.b, 0.75f);
+  EXPECT_FLOAT_EQ(least.r, 0.23f + 0.6f * (0.95f - 0.23f));
+  EXPECT_FLOAT_EQ(least.b, 0.75f + 0.6f * (0.95f - 0.75f));
+  EXPECT_FLOAT_EQ(middle.r, 0.23f + 0.3f * (0.95f - 0.23f));
+  // All tensile: from 40 % of the way from white to red, to red.
+  const Range tensile = autoRange({1.0, 3.0}, true);
+  EXPECT_FLOAT_EQ(colorOf(1.0, tensile).g, 0.95f + 0.4f * (0.02f - 0.95f));
+  EXPECT_FLOAT_EQ(colorOf(3.0, tensile).r, 0.71f);
   const Range plain = autoRange({1.0, 3.0}, false);
   EXPECT_DOUBLE_EQ(plain.min, 1.0);
   EXPECT_DOUBLE_EQ(plain.max, 3.0);

@@ -11,15 +11,19 @@ struct Rgb {
   float r = 0, g = 0, b = 0;
 };
 
-/// A value range, fixed or taken from the data.
+/// A value range, fixed or taken from the data, and the part of the blue–white–red map it spans.
 struct Range {
   double min = 0.0;
   double max = 1.0;
+  double map_from = 0.0;  ///< where `min` sits on the map: 0 blue, 0.5 white, 1 red
+  double map_to = 1.0;    ///< where `max` sits
 };
 
-/// The range of `values` (finite ones); symmetric about 0 when `symmetric` and the values change
-/// sign; never empty.
-Range autoRange(const std::vector<double>& values, bool symmetric);
+/// The range of `values` (finite ones); never empty. With `signed_values` (a field whose sign
+/// means something, as σ_zz's compression) values that change sign get a range symmetric about 0,
+/// and one-signed values keep their own range on their half of the map, short of the white kept for
+/// zero: negatives blue to pale blue, positives pale red to red; an all-compressive σ_zz shows no red.
+Range autoRange(const std::vector<double>& values, bool signed_values);
 
 /// Maps `value` in `range` to a diverging blue–white–red colour (below/above the range: clamped;
 /// NaN: grey). Diverging, because stresses change sign.
