@@ -418,7 +418,7 @@ def write(data):
     # 5. Fronts
     extended = [e for v in heights.values() for e in v if f(e, "rupture_length_m") > 0]
     speeds_all = [f(e, "median_front_speed_m_s") for e in extended if math.isfinite(f(e, "median_front_speed_m_s"))]
-    together = len(extended) - len(speeds_all)
+    together = sum(1 for e in extended if math.isnan(f(e, "median_front_speed_m_s")) and int(e["nodes_faster_than_c_l"]) > 0)
     slow = sum(1 for s in speeds_all if s < 0.1 * C_R)
     sub = sum(1 for s in speeds_all if 0.1 * C_R <= s < C_R)
     mid = sum(1 for s in speeds_all if C_R <= s < C_S)
@@ -444,7 +444,7 @@ def write(data):
         ax5a.plot([p[0] for p in points], [p[1] for p in points], marker=".", label=label)
         speeds_here = [p[1] for p in points]
         # Above c_L the fit sees nodes unsticking almost together, not a running front.
-        running = [v for v in speeds_here if v < C_L]
+        running = [v for v in speeds_here if v <= C_L]
         median = float(numpy.median(running)) if running else None
         arrest = "-" if e["global"] == "1" else "%.0f" % points[-1][1]
         profile_rows.append("| %s | %.0f–%.0f | %.0f | %s | %.0f | %s |" % (

@@ -2,7 +2,8 @@
 // interface camera's frames and the load cells, as an experimentalist has them. An event starts at a
 // frame with a sliding node after an all-stuck frame and ends at the next all-stuck frame; the slipped
 // nodes are those seen sliding in between. The simulator publishes a frame at every step where a node
-// unsticks and where an event ends, so the camera misses no node's slip and no event.
+// unsticks and where an event ends, so the camera misses no node's slip and no event, provided that
+// every frame arrives (a frame lost, or a bag recorded before that rule, can hide a short slip).
 #pragma once
 
 #include <deque>

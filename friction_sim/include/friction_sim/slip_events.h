@@ -59,7 +59,7 @@ class SlipEventDetector {
 };
 
 /// m/s, front speed per node from first-unstick times t(x) (NaN = not slipped): a linear fit of t against
-/// x over `fit_nodes` consecutive slipped nodes centred on each node (one more behind than ahead when
+/// x over `fit_nodes` consecutive slipped nodes centred on each node (one more at lower x when
 /// even; fewer at the ends and at unslipped gaps); v_c = 1/|dt/dx| (inf if simultaneous).
 std::vector<double> frontSpeeds(const std::vector<double>& positions,
                                 const std::vector<double>& first_unstick_time, int fit_nodes);
@@ -76,12 +76,15 @@ WaveSpeeds waveSpeeds(const Scene& scene);
 
 /// An event's front speed in one number.
 struct FrontSpeedSummary {
-  /// m/s, median v_c over the nodes whose fit is at most c_L; NaN if there are none
+  /// m/s, median v_c over the nodes whose fit is finite and at most c_L (the mean of the middle two
+  /// for an even count); NaN if there are none. Fits just below c_L next to a nucleation patch stay in.
   double median = 0.0;
-  /// nodes whose fit is faster than c_L (inf included): they unstuck too nearly together for a running
+  /// nodes whose fit is faster than c_L or infinite: they unstuck too nearly together for a running
   /// front, as where the pusher's load fails several nodes at once; left out of the median
   int faster_than_longitudinal = 0;
 };
+/// `longitudinal_speed` ≤ 0 means unknown (an analysis node without the scene): then only infinite
+/// fits are left out.
 FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed, double longitudinal_speed);
 
 }  // namespace friction

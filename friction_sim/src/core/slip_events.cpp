@@ -83,8 +83,8 @@ std::vector<double> frontSpeeds(const std::vector<double>& positions,
                                 const std::vector<double>& first_unstick_time, int fit_nodes) {
   const int n = static_cast<int>(positions.size());
   std::vector<double> speed(n, kNaN);
-  // A window of fit_nodes nodes: as many behind the centre as ahead, one more behind when even (the
-  // nodes the front has crossed, so that the last node before an arrest has a speed).
+  // A window of fit_nodes nodes: as many at lower x as at higher, one more at lower x when even (for a
+  // front from the trailing edge, the nodes it has crossed: the last node before an arrest has a speed).
   const int behind = std::max(fit_nodes, 2) / 2, ahead = (std::max(fit_nodes, 2) - 1) / 2;
   for (int centre = 0; centre < n; ++centre) {
     if (std::isnan(first_unstick_time[centre])) continue;
@@ -127,10 +127,11 @@ WaveSpeeds waveSpeeds(const Scene& scene) {
 
 FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed, double longitudinal_speed) {
   FrontSpeedSummary summary;
+  const bool limit_known = longitudinal_speed > 0.0;
   std::vector<double> running;
   for (double speed : front_speed) {
     if (std::isnan(speed)) continue;
-    if (speed <= longitudinal_speed) {
+    if (std::isfinite(speed) && (!limit_known || speed <= longitudinal_speed)) {
       running.push_back(speed);
     } else {
       ++summary.faster_than_longitudinal;
@@ -138,10 +139,11 @@ FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed, d
   }
   if (running.empty()) {
     summary.median = kNaN;
-  } else {
-    std::nth_element(running.begin(), running.begin() + running.size() / 2, running.end());
-    summary.median = running[running.size() / 2];
+    return summary;
   }
+  std::sort(running.begin(), running.end());
+  const std::size_t middle = running.size() / 2;
+  summary.median = running.size() % 2 ? running[middle] : 0.5 * (running[middle - 1] + running[middle]);
   return summary;
 }
 

@@ -193,10 +193,11 @@ void RigSimulator::publishAcrossJump(const LoadCellReading& cells_before, const 
   }
 }
 
-void RigSimulator::publishInstruments(bool event_boundary, bool node_unstuck) {
+void RigSimulator::publishInstruments() {
   const double t = simulation_->time();
   const std::string& frame = options_.frame_id;
   if (due(t, next_clock_, options_.clock_rate)) publishClock(t);
+  const bool event_boundary = simulation_->eventStartedLastStep() || simulation_->eventEndedLastStep();
   if (due(t, next_load_cells_, options_.load_cell_rate) || event_boundary) {
     emit(load_cells_pub_, "load_cells", toMsg(simulation_->loadCells(), frame));
   }
@@ -204,7 +205,7 @@ void RigSimulator::publishInstruments(bool event_boundary, bool node_unstuck) {
     emit(gauges_pub_, "strain_gauges", toMsg(simulation_->gaugeProfile(), frame));
   }
   const double frame_rate = simulation_->inEvent() ? options_.interface_rate : options_.interface_idle_rate;
-  if (event_boundary || node_unstuck || t >= next_frame_) {
+  if (simulation_->interfaceChangedLastStep() || t >= next_frame_) {
     emit(interface_pub_, "interface", toMsg(simulation_->interfaceFrame(), frame_index_++, frame));
     next_frame_ = t + 1.0 / frame_rate;
   }
@@ -321,8 +322,7 @@ void RigSimulator::run() {
         may_jump && scene_.model == ModelKind::Lattice2D ? simulation_->gaugeProfile() : GaugeProfile{};
     simulation_->advance(until);
     if (simulation_->jumps() != jumps) publishAcrossJump(cells_before, gauges_before);
-    publishInstruments(simulation_->eventStartedLastStep() || simulation_->eventEndedLastStep(),
-                       !simulation_->contact().unstuckLastStep().empty());
+    publishInstruments();
     if (options_.stop_at_scene_end && simulation_->finished()) {
       ROS_INFO_STREAM("scene ended: " << simulation_->stopReason());
       break;

@@ -9,6 +9,7 @@
 //   load_cells (geometry_msgs/WrenchStamped), interface (friction_msgs/InterfaceState)
 // Published topics (private):
 //   ~slip_events (friction_msgs/SlipEvent), ~precursor_points (friction_msgs/PrecursorPoint)
+//   The events' wave speeds are 0 (unknown): the instruments do not tell them.
 //
 // When time jumps backwards (looped playback), it forgets everything and starts over.
 #pragma once

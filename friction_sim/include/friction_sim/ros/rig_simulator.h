@@ -97,7 +97,7 @@ class RigSimulator {
  private:
   void advertise();
   void startSimulation();
-  void publishInstruments(bool event_boundary, bool node_unstuck);
+  void publishInstruments();
   /// After a fast-forward jump: the load cells, gauges, stage state and clock at every publication time
   /// the jump passed, interpolated (the statics are affine in time along a jump).
   void publishAcrossJump(const LoadCellReading& cells_before, const GaugeProfile& gauges_before);
