@@ -443,14 +443,13 @@ def write(data):
         label = "global" if e["global"] == "1" else "precursor %s" % e["index"]
         ax5a.plot([p[0] for p in points], [p[1] for p in points], marker=".", label=label)
         speeds_here = [p[1] for p in points]
-        # Above c_L the fit sees nodes unsticking almost together, not a running front.
-        running = [v for v in speeds_here if v <= C_L]
-        median = float(numpy.median(running)) if running else None
+        # The runner's median leaves out fits above c_L: nodes unsticking almost together, not a running front.
+        median = f(e, "median_front_speed_m_s")
         arrest = "-" if e["global"] == "1" else "%.0f" % points[-1][1]
         profile_rows.append("| %s | %.0f–%.0f | %.0f | %s | %.0f | %s |" % (
             label, points[0][0], points[-1][0], min(speeds_here),
-            "%.0f" % median if running else "-", max(speeds_here), arrest))
-        if e["global"] != "1" and running:
+            "%.0f" % median if math.isfinite(median) else "-", max(speeds_here), arrest))
+        if e["global"] != "1" and math.isfinite(median):
             arrest_ratios.append((points[-1][1] / median, points[-1][1] < C_R))
     save_speed_figure(fig5a, ax5a, "x (mm)", "validation_front_profiles.png")
     L += ["Front speed profiles v_c(x) of the default run (speed from a sliding fit of first-unstick times over "

@@ -42,8 +42,6 @@ class Simulation : public Dynamics {
   /// once (the 2D lattice), only. For callers that need the state after every step only around events
   /// and at their own sample times.
   void advance(double until, double group_before = 0.0);
-  /// The former advance(until, two_steps): its `true` would now read as group_before = 1 s.
-  void advance(double until, bool two_steps) = delete;
   /// Advances until the scene's stop condition holds.
   void run();
   /// True while the slider sits in static equilibrium with no node sliding (fast-forward can jump).
