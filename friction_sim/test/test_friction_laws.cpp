@@ -13,7 +13,8 @@ constexpr double kMuS = 0.4, kMuK = 0.17;
 /// One interface node (a single block) whose forces the test sets by hand.
 class OneNode : public ::testing::Test {
  protected:
-  OneNode() : block_(blockScene()), contact_(std::make_unique<AmontonsCoulomb>(kMuS, kMuK), block_, 0.0) {
+  OneNode() : OneNode(std::make_unique<AmontonsCoulomb>(kMuS, kMuK)) {}
+  explicit OneNode(std::unique_ptr<FrictionLaw> law) : block_(blockScene()), contact_(std::move(law), block_, 0.0) {
     u_ = Vector::Zero(1);
     v_ = Vector::Zero(1);
     contact_.reset(u_);
@@ -174,6 +175,26 @@ TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
   const double acceleration = (5.0 - kMuK * 10.0) / mass;
   EXPECT_DOUBLE_EQ(v_[0], acceleration * 0.5 * dt);
   EXPECT_DOUBLE_EQ(u_[0], 0.5 * acceleration * 0.25 * dt * dt);
+}
+
+/// The same node under linear slip weakening over ξ_µ = 0.1 µm.
+class OneWeakeningNode : public OneNode {
+ protected:
+  static constexpr double kWeakeningLength = 1e-7;
+  OneWeakeningNode() : OneNode(std::make_unique<LinearSlipWeakening>(kMuS, kMuK, kWeakeningLength)) {}
+};
+
+TEST_F(OneWeakeningNode, TheCatchUpSlipWeakensFriction) {
+  update(3.0, 10.0);
+  net(5.0, 10.0);  // crosses µ_s·N halfway through the step
+  const double dt = 1e-3, mass = 2.0;
+  ASSERT_TRUE(contact_.updateStates(u_, v_, dt, mass));
+  // Unweakened at the crossing, µ = µ_s: it catches up ½·a·(dt/2)² = 62.5 nm, 0.625 ξ_µ.
+  const double catch_up = 0.5 * ((5.0 - kMuS * 10.0) / mass) * 0.25 * dt * dt;
+  ASSERT_DOUBLE_EQ(u_[0], catch_up);
+  const double weakened = kMuS - (kMuS - kMuK) * catch_up / kWeakeningLength;
+  EXPECT_DOUBLE_EQ(weakened, 0.25625);
+  EXPECT_DOUBLE_EQ(net(5.0, 10.0), 5.0 - weakened * 10.0);
 }
 
 TEST_F(OneNode, CrossingIsInterpolatedFromTheLoadAtTheLastUpdateUnderItsOwnNormalForce) {

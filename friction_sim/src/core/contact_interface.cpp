@@ -303,6 +303,9 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     u[dof] += catch_up;
     v[dof] += acceleration * late;
     dissipation_ -= sliding_friction * catch_up;
+    // Slip weakening counts the catch-up too: it is slip since unsticking that no step will measure.
+    law_->onSlip(node, catch_up);
+    refreshCoefficients(node);
     changed = true;
   }
   rotateLoads();
