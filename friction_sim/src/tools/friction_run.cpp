@@ -1,12 +1,5 @@
 // friction_run: runs a scene offline (no ROS master) to its stop condition and writes the results.
-//
-//   friction_run SCENE.yaml [--out DIR] [--set key=value]...
-//
-// Writes DIR/events.csv (one row per slip event), DIR/event_nodes.csv (per event and interface node:
-// slip, first-unstick time, front speed), DIR/loading.csv (load cells at instruments.loading_curve_rate),
-// DIR/stresses.csv (per event, at its onset and its end: the strain gauges along x and the interface
-// stresses per node), DIR/scene.yaml (the scene as run) and DIR/summary.txt (also printed). DIR defaults to
-// results/<scene name>. `--set pusher.height=0.01` overrides one scene field (validated like the file).
+// `friction_run --help` lists its arguments and the files it writes (help() below).
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -20,12 +13,26 @@
 namespace {
 
 int usage() {
-  std::cerr << "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...\n";
+  std::cerr << "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...  (--help for more)\n";
   return 2;
+}
+
+int help() {
+  std::cout << "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...\n\n"
+               "Runs a scene offline to its stop condition and writes, in DIR (default results/<scene name>):\n"
+               "  events.csv       one row per slip event (onset, F_X, F_Z, extent, L_p, front speeds)\n"
+               "  event_nodes.csv  per event and interface node: slip, first-unstick time, front speed\n"
+               "  loading.csv      the load cells at instruments.loading_curve_rate\n"
+               "  stresses.csv     per event, at onset and end: strain gauges and interface stresses\n"
+               "  scene.yaml       the scene as run;  summary.txt  the summary, also printed\n\n"
+               "  --set key=value  overrides one scene field, e.g. --set pusher.height=0.01 (SI units);\n"
+               "                   validated like the file: a bad scene is refused with every problem listed.\n";
+  return 0;
 }
 
 int run(int argc, char** argv) {
   if (argc < 2) return usage();
+  if (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") return help();
   std::string scene_path = argv[1], out_dir;
   std::vector<std::pair<std::string, std::string>> overrides;
   for (int i = 2; i < argc; ++i) {
