@@ -1,6 +1,7 @@
 #include "friction_rviz/history.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace friction_rviz {
 
@@ -14,6 +15,21 @@ bool SeriesHistory::add(double time, double value) {
     values_.pop_front();
   }
   return jumped;
+}
+
+EventKind eventKind(bool global_event, double rupture_length) {
+  if (global_event) return EventKind::Global;
+  return rupture_length == 0.0 ? EventKind::SingleNodeSlip : EventKind::Precursor;
+}
+
+void PrecursorScatter::add(double onset_shear_force, double onset_normal_force, double rupture_length,
+                           double slider_length, bool global_event) {
+  const double shear_ratio = onset_shear_force / onset_normal_force;
+  const double length_ratio = rupture_length / slider_length;
+  if (!std::isfinite(shear_ratio) || !std::isfinite(length_ratio)) return;
+  Points& points = points_[static_cast<int>(eventKind(global_event, rupture_length))];
+  points.shear_ratio.push_back(shear_ratio);
+  points.length_ratio.push_back(length_ratio);
 }
 
 void SpaceTimeHistory::clear() {

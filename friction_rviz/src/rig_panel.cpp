@@ -32,7 +32,7 @@ void PlotWidget::setSeries(std::vector<Series> series) {
 void PlotWidget::paintEvent(QPaintEvent*) {
   QPainter painter(this);
   painter.fillRect(rect(), Qt::white);
-  const QRectF area(46, 8, width() - 56, height() - 34);
+  const QRectF area(74, 8, width() - 84, height() - 34);
   painter.setPen(Qt::gray);
   painter.drawRect(area);
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
@@ -43,21 +43,44 @@ void PlotWidget::paintEvent(QPaintEvent*) {
   painter.setPen(Qt::black);
   painter.drawText(QRectF(area.left(), area.bottom() + 4, area.width(), 16), Qt::AlignCenter, x_label_);
   painter.save();
-  painter.translate(12, area.center().y());
+  painter.translate(10, area.center().y());
   painter.rotate(-90);
   painter.drawText(QRectF(-area.height() / 2, -10, area.height(), 16), Qt::AlignCenter, y_label_);
   painter.restore();
   if (!(x0 < x1)) return;
   y0 = std::min(y0, 0.0);
   if (!(y0 < y1)) y1 = y0 + 1.0;
-  painter.drawText(QRectF(0, area.top() - 2, 44, 14), Qt::AlignRight, QString::number(y1, 'g', 3));
-  painter.drawText(QRectF(0, area.bottom() - 12, 44, 14), Qt::AlignRight, QString::number(y0, 'g', 3));
+  // The legend, one row, gets its own band at the top, so that no data is drawn under it.
+  const bool legend = std::any_of(series_.begin(), series_.end(), [](const Series& s) { return !s.label.isEmpty(); });
+  // Inset a little, so that markers at the ends are drawn whole.
+  const QRectF data_area = area.adjusted(5, legend ? 22.0 : 5.0, -5, -5);
+  painter.drawText(QRectF(20, data_area.top() - 7, 50, 14), Qt::AlignRight, QString::number(y1, 'g', 4));
+  painter.drawText(QRectF(20, data_area.bottom() - 7, 50, 14), Qt::AlignRight, QString::number(y0, 'g', 4));
+  painter.drawText(QRectF(area.left(), area.bottom() + 4, 80, 16), Qt::AlignLeft, QString::number(x0, 'g', 4));
+  painter.drawText(QRectF(area.right() - 80, area.bottom() + 4, 80, 16), Qt::AlignRight, QString::number(x1, 'g', 4));
   auto map = [&](double x, double y) {
-    return QPointF(area.left() + (x - x0) / (x1 - x0) * area.width(), area.bottom() - (y - y0) / (y1 - y0) * area.height());
+    return QPointF(data_area.left() + (x - x0) / (x1 - x0) * data_area.width(),
+                   data_area.bottom() - (y - y0) / (y1 - y0) * data_area.height());
   };
+  double legend_x = area.left() + 8;
   for (const Series& s : series_) {
     painter.setPen(QPen(s.colour, 1.5));
-    painter.setBrush(s.colour);
+    if (s.hollow) {
+      painter.setBrush(Qt::NoBrush);
+    } else {
+      painter.setBrush(s.colour);
+    }
+    if (!s.label.isEmpty()) {
+      const QPointF key(legend_x + 6, area.top() + 10);
+      if (s.points) {
+        painter.drawEllipse(key, 3, 3);
+      } else {
+        painter.drawLine(key - QPointF(6, 0), key + QPointF(6, 0));
+      }
+      const double text_width = painter.fontMetrics().horizontalAdvance(s.label);
+      painter.drawText(QRectF(key.x() + 10, area.top() + 2, text_width + 2, 18), Qt::AlignLeft, s.label);
+      legend_x += text_width + 36;
+    }
     if (s.points) {
       for (std::size_t i = 0; i < s.x.size(); ++i) painter.drawEllipse(map(s.x[i], s.y[i]), 3, 3);
       continue;
@@ -138,9 +161,7 @@ void RigPanel::connectToRig() {
   pause_client_ = rig.serviceClient<std_srvs::SetBool>("pause");
   shear_.clear();
   normal_.clear();
-  shear_ratio_.clear();
-  length_ratio_.clear();
-  global_.clear();
+  events_.clear();
   Q_EMIT configChanged();
 }
 
@@ -149,17 +170,14 @@ void RigPanel::onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
   if (shear_.add(t, msg->wrench.force.x)) {
     // Time jumped back (looped playback or a reset): the panel starts over.
     normal_.clear();
-    shear_ratio_.clear();
-    length_ratio_.clear();
-    global_.clear();
+    events_.clear();
   }
   normal_.add(t, msg->wrench.force.z);
 }
 
 void RigPanel::onEvent(const friction_msgs::SlipEvent::ConstPtr& msg) {
-  shear_ratio_.push_back(msg->onset_shear_force / msg->onset_normal_force);
-  length_ratio_.push_back(msg->rupture_length / msg->slider_length);
-  global_.push_back(msg->global_event);
+  events_.add(msg->onset_shear_force, msg->onset_normal_force, msg->rupture_length, msg->slider_length,
+              msg->global_event);
 }
 
 void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
@@ -167,24 +185,30 @@ void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
 }
 
 void RigPanel::refresh() {
-  auto series = [](const SeriesHistory& h, QColor colour) {
+  auto series = [](const SeriesHistory& h, QColor colour, const char* label) {
     PlotWidget::Series s;
     s.x.assign(h.times().begin(), h.times().end());
     s.y.assign(h.values().begin(), h.values().end());
     s.colour = colour;
+    s.label = label;
     return s;
   };
-  loading_plot_->setSeries({series(shear_, QColor(20, 20, 20)), series(normal_, QColor(60, 120, 200))});
-  PlotWidget::Series precursors, global;
-  precursors.colour = QColor(40, 90, 220);
-  global.colour = QColor(210, 30, 30);
-  precursors.points = global.points = true;
-  for (std::size_t i = 0; i < shear_ratio_.size(); ++i) {
-    auto& s = global_[i] ? global : precursors;
-    s.x.push_back(shear_ratio_[i]);
-    s.y.push_back(length_ratio_[i]);
-  }
-  precursor_plot_->setSeries({precursors, global});
+  loading_plot_->setSeries(
+      {series(shear_, QColor(20, 20, 20), "F_X (stage spring)"), series(normal_, QColor(60, 120, 200), "F_Z")});
+  auto events = [this](EventKind kind, QColor colour, bool hollow, const char* label) {
+    PlotWidget::Series s;
+    s.x = events_.points(kind).shear_ratio;
+    s.y = events_.points(kind).length_ratio;
+    s.colour = colour;
+    s.points = true;
+    s.hollow = hollow;
+    s.label = label;
+    return s;
+  };
+  const QColor blue(40, 90, 220);
+  precursor_plot_->setSeries({events(EventKind::Precursor, blue, false, "precursor"),
+                              events(EventKind::SingleNodeSlip, blue, true, "single-node slip (L_p = 0)"),
+                              events(EventKind::Global, QColor(210, 30, 30), false, "global event")});
   const char* modes[] = {"velocity", "hold", "position"};
   state_label_->setText(QString("stage: t = %1 s, %2, X_s = %3 mm, V = %4 mm/s, F_X = %5 N, F_Z = %6 N, "
                                 "global events %7%8")

@@ -33,7 +33,9 @@ class PlotWidget : public QWidget {
   struct Series {
     std::vector<double> x, y;
     QColor colour;
-    bool points = false;
+    bool points = false;  ///< markers rather than a line
+    bool hollow = false;  ///< markers outlined only
+    QString label;        ///< in the legend; none if empty
   };
   void setSeries(std::vector<Series> series);
   QSize sizeHint() const override { return QSize(320, 160); }
@@ -75,8 +77,7 @@ class RigPanel : public rviz::Panel {
   QLabel *state_label_, *reply_label_;
   PlotWidget *loading_plot_, *precursor_plot_;
   SeriesHistory shear_{20000}, normal_{20000};
-  std::vector<double> shear_ratio_, length_ratio_;
-  std::vector<bool> global_;
+  PrecursorScatter events_;
   friction_msgs::StageState last_state_;
 };
 

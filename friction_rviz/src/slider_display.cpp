@@ -27,7 +27,8 @@ std::string shortNumber(double value) {
 }  // namespace
 
 SliderDisplay::SliderDisplay() {
-  magnification_ = new rviz::FloatProperty("Magnification", 300.0,
+  // 100: at 300 the cells under the pusher of the default experiment fold over each other.
+  magnification_ = new rviz::FloatProperty("Magnification", 100.0,
                                            "Displacements are drawn this many times larger (they are micrometres "
                                            "on a 14 cm slider).",
                                            this, SLOT(markDirty()));

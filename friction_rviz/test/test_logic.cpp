@@ -70,6 +70,28 @@ TEST(History, SeriesKeepsAtMostItsCapacityAndClearsWhenTimeJumpsBack) {
   EXPECT_DOUBLE_EQ(history.values().front(), 1.0);
 }
 
+TEST(History, PrecursorPlotTellsSingleNodeSlipsFromPrecursorsAndGlobalEvents) {
+  PrecursorScatter scatter;
+  scatter.add(192.0, 1920.0, 0.0, 0.14, false);    // one node alone
+  scatter.add(276.0, 1920.0, 0.035, 0.14, false);  // a precursor a quarter of the slider long
+  scatter.add(399.0, 1920.0, 0.14, 0.14, true);
+  scatter.add(100.0, 0.0, 0.01, 0.14, false);      // no normal load: no F_X/F_Z to plot
+  const auto& single = scatter.points(EventKind::SingleNodeSlip);
+  const auto& precursors = scatter.points(EventKind::Precursor);
+  const auto& global = scatter.points(EventKind::Global);
+  ASSERT_EQ(single.shear_ratio.size(), 1u);
+  EXPECT_DOUBLE_EQ(single.shear_ratio[0], 0.1);
+  EXPECT_DOUBLE_EQ(single.length_ratio[0], 0.0);
+  ASSERT_EQ(precursors.shear_ratio.size(), 1u);
+  EXPECT_DOUBLE_EQ(precursors.shear_ratio[0], 0.14375);
+  EXPECT_DOUBLE_EQ(precursors.length_ratio[0], 0.25);
+  ASSERT_EQ(global.length_ratio.size(), 1u);
+  EXPECT_DOUBLE_EQ(global.length_ratio[0], 1.0);
+  EXPECT_EQ(eventKind(true, 0.0), EventKind::Global);  // a one-node interface's global event
+  scatter.clear();
+  EXPECT_TRUE(scatter.points(EventKind::Global).shear_ratio.empty());
+}
+
 TEST(History, SpaceTimeStripOutlinesEventsWithTheirSlippedRange) {
   SpaceTimeHistory strip(4);
   const std::vector<double> x{0.0, 0.01, 0.02, 0.03};

@@ -3,6 +3,7 @@
 // a reset).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <deque>
 #include <vector>
@@ -22,6 +23,28 @@ class SeriesHistory {
  private:
   std::size_t capacity_;
   std::deque<double> times_, values_;
+};
+
+/// The kinds of slip event the panel's L_p/L against F_X/F_Z plot tells apart.
+enum class EventKind { Precursor = 0, SingleNodeSlip = 1, Global = 2 };
+/// A global event ran over the whole interface; of the others, one with L_p = 0 is a single node slipping
+/// alone (no front ran), as the runner's summary and rig_report count them.
+EventKind eventKind(bool global_event, double rupture_length);
+
+/// The points of the precursor plot, (F_X/F_Z at onset, L_p/L), by kind.
+class PrecursorScatter {
+ public:
+  struct Points {
+    std::vector<double> shear_ratio, length_ratio;
+  };
+  /// Forces in N, lengths in m. An event whose ratios are not finite (F_Z or L zero) adds no point.
+  void add(double onset_shear_force, double onset_normal_force, double rupture_length, double slider_length,
+           bool global_event);
+  void clear() { points_ = {}; }
+  const Points& points(EventKind kind) const { return points_[static_cast<int>(kind)]; }
+
+ private:
+  std::array<Points, 3> points_;
 };
 
 /// A slip event as the space–time strip outlines it.
