@@ -166,6 +166,19 @@ TEST_F(OneNode, LosesContactAtZeroNormalForceAndRecovers) {
   EXPECT_EQ(contact_.state(0), ContactState::Stuck);  // returns at rest: sticks
 }
 
+TEST_F(OneNode, NodeSlidingOffOnLandingUnsticksAtTheEndOfTheStep) {
+  update(3.0, 10.0);
+  net(5.0, 10.0);
+  ASSERT_TRUE(contact_.updateStates(u_, v_, 1e-3, 2.0));
+  ASSERT_DOUBLE_EQ(contact_.transitionFraction(0), 0.5);  // unstuck halfway through a step
+  ASSERT_TRUE(update(1.0, 0.0));                          // lifts off, still moving
+  ASSERT_EQ(contact_.state(0), ContactState::Detached);
+  ASSERT_TRUE(update(1.0, 10.0));  // lands moving: slides on, and counts as unsticking at this update
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  ASSERT_EQ(contact_.unstuckLastStep(), std::vector<int>{0});
+  EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), 1.0);
+}
+
 TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
   update(3.0, 10.0);  // load ratio 0.75
   net(5.0, 10.0);  // load ratio 1.25: crossed µ_s·N halfway through the step

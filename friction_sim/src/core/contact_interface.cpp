@@ -272,6 +272,9 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
       continue;
     }
     if (state_[node] == ContactState::Detached) {
+      // Contact returns as this update sees it, at the step's end; the fraction of its last transition
+      // is stale.
+      transition_fraction_[node] = 1.0;
       if (v[dof] != 0.0) {
         startSliding(node, v[dof] > 0.0 ? 1 : -1);
       } else {
