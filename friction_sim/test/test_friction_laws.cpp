@@ -205,9 +205,16 @@ TEST_F(OneWeakeningNode, TheCatchUpSlipWeakensFriction) {
   // Unweakened at the crossing, µ = µ_s: it catches up ½·a·(dt/2)² = 62.5 nm, 0.625 ξ_µ.
   const double catch_up = 0.5 * ((5.0 - kMuS * 10.0) / mass) * 0.25 * dt * dt;
   ASSERT_DOUBLE_EQ(u_[0], catch_up);
-  const double weakened = kMuS - (kMuS - kMuK) * catch_up / kWeakeningLength;
-  EXPECT_DOUBLE_EQ(weakened, 0.25625);
-  EXPECT_DOUBLE_EQ(net(5.0, 10.0), 5.0 - weakened * 10.0);
+  // µ = 0.4 − 0.23 · 0.625 = 0.25625
+  EXPECT_DOUBLE_EQ(net(5.0, 10.0), 5.0 - (kMuS - (kMuS - kMuK) * catch_up / kWeakeningLength) * 10.0);
+  // The next step measures its slip from after the catch-up: δ is the sum, each counted once.
+  contact_.beginStep(u_, v_);
+  const double step_slip = 20e-9;
+  u_[0] += step_slip;
+  v_[0] += 1e-6;  // still sliding forwards
+  contact_.finishStep(u_, v_, dt);
+  EXPECT_DOUBLE_EQ(net(5.0, 10.0),
+                   5.0 - (kMuS - (kMuS - kMuK) * (catch_up + step_slip) / kWeakeningLength) * 10.0);
 }
 
 TEST_F(OneNode, CrossingIsInterpolatedFromTheLoadAtTheLastUpdateUnderItsOwnNormalForce) {

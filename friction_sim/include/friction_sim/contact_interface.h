@@ -111,6 +111,8 @@ class ContactInterface {
   void startSliding(int node, int direction);
   /// The law's coefficients for `node` after its state or slip changed.
   void refreshCoefficients(int node);
+  /// `node` slid by `slip` (m): the law learns of it and its coefficients follow.
+  void addSlip(int node, double slip);
   /// Forgets a node's load history (it has just stuck).
   void clearLoad(int node);
   /// At the end of a state update: its loads become the next update's previous ones.

@@ -22,7 +22,7 @@ class FrictionLaw {
   virtual double slidingCoefficient(int node) const = 0;
   /// `node` has just unstuck.
   virtual void onUnstick(int node) = 0;
-  /// `node` slid by |slip| (m) during the last step.
+  /// `node` slid by |slip| (m): during the last step, or in the catch-up of a node that unstuck within it.
   virtual void onSlip(int node, double slip) = 0;
   /// True if every node has the same µ_s and the same sliding µ at all times: the friction loop then
   /// reads two numbers rather than two per-node arrays.

@@ -214,8 +214,7 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
       }
       const double slip = u[dof] - start_u_[node];
       dissipation_ -= start_friction_[node] * slip;
-      law_->onSlip(node, slip);
-      refreshCoefficients(node);
+      addSlip(node, slip);
     }
   }
   for (int node : unstuck_last_step_) just_unstuck_[node] = 0;  // the only nodes flagged
@@ -226,6 +225,11 @@ void ContactInterface::stick(int node, const Vector& u) {
   setState(node, ContactState::Stuck);
   anchor_[node] = u[dofs_[node]];
   clearLoad(node);
+}
+
+void ContactInterface::addSlip(int node, double slip) {
+  law_->onSlip(node, slip);
+  refreshCoefficients(node);
 }
 
 void ContactInterface::clearLoad(int node) {
@@ -299,6 +303,8 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     // It slides opposite to the friction that held it.
     startSliding(node, friction_[current_slot_][node] > 0.0 ? -1 : 1);
     const double late = (1.0 - transition_fraction_[node]) * dt;
+    // At the coefficient of the moment it unstuck: weakening within the catch-up itself (a fraction of
+    // one step's slip) is left out, in the motion and in the dissipation alike.
     const double sliding_friction = -sliding_coefficient_[node] * normal * friction_mode_[node];
     const double acceleration = (other_force_[node] + sliding_friction) / node_mass;
     const double catch_up = 0.5 * acceleration * late * late;
@@ -307,8 +313,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     v[dof] += acceleration * late;
     dissipation_ -= sliding_friction * catch_up;
     // Slip weakening counts the catch-up too: it is slip since unsticking that no step will measure.
-    law_->onSlip(node, catch_up);
-    refreshCoefficients(node);
+    addSlip(node, catch_up);
     changed = true;
   }
   rotateLoads();
