@@ -12,13 +12,15 @@
 
 namespace {
 
+constexpr const char* kUsage = "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...";
+
 int usage() {
-  std::cerr << "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...  (--help for more)\n";
+  std::cerr << kUsage << "  (--help for more)\n";
   return 2;
 }
 
 int help() {
-  std::cout << "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...\n\n"
+  std::cout << kUsage << "\n\n"
                "Runs a scene offline to its stop condition and writes, in DIR (default results/<scene name>):\n"
                "  events.csv       one row per slip event (onset, F_X, F_Z, extent, L_p, front speeds)\n"
                "  event_nodes.csv  per event and interface node: slip, first-unstick time, front speed\n"
@@ -31,8 +33,10 @@ int help() {
 }
 
 int run(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") return help();
+  }
   if (argc < 2) return usage();
-  if (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") return help();
   std::string scene_path = argv[1], out_dir;
   std::vector<std::pair<std::string, std::string>> overrides;
   for (int i = 2; i < argc; ++i) {
