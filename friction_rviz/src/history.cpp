@@ -17,17 +17,20 @@ bool SeriesHistory::add(double time, double value) {
   return jumped;
 }
 
-EventKind eventKind(bool global_event, double rupture_length) {
+EventKind eventKind(bool global_event, double rupture_length, bool after_a_global_event) {
   if (global_event) return EventKind::Global;
+  if (after_a_global_event) return EventKind::AfterGlobal;
   return rupture_length == 0.0 ? EventKind::SingleNodeSlip : EventKind::Precursor;
 }
 
 void PrecursorScatter::add(double onset_shear_force, double onset_normal_force, double rupture_length,
                            double slider_length, bool global_event) {
+  const EventKind kind = eventKind(global_event, rupture_length, seen_global_);
+  seen_global_ = seen_global_ || global_event;
   const double shear_ratio = onset_shear_force / onset_normal_force;
   const double length_ratio = rupture_length / slider_length;
   if (!std::isfinite(shear_ratio) || !std::isfinite(length_ratio)) return;
-  Points& points = points_[static_cast<int>(eventKind(global_event, rupture_length))];
+  Points& points = points_[static_cast<int>(kind)];
   points.shear_ratio.push_back(shear_ratio);
   points.length_ratio.push_back(length_ratio);
 }

@@ -47,13 +47,31 @@ void PlotWidget::paintEvent(QPaintEvent*) {
   painter.rotate(-90);
   painter.drawText(QRectF(-area.height() / 2, -10, area.height(), 16), Qt::AlignCenter, y_label_);
   painter.restore();
-  if (!(x0 < x1)) return;
+  if (x0 == x1) {  // one point so far, or one value: centred
+    const double pad = x0 != 0.0 ? 0.05 * std::abs(x0) : 1.0;
+    x0 -= pad;
+    x1 += pad;
+  }
+  if (!(x0 < x1)) return;  // no data
   y0 = std::min(y0, 0.0);
   if (!(y0 < y1)) y1 = y0 + 1.0;
-  // The legend, one row, gets its own band at the top, so that no data is drawn under it.
-  const bool legend = std::any_of(series_.begin(), series_.end(), [](const Series& s) { return !s.label.isEmpty(); });
+  // The legend gets its own band at the top, so that no data is drawn under it; its entries go left to
+  // right, on as many rows as the width needs.
+  constexpr double kRow = 18.0, kKey = 30.0, kGap = 14.0;
+  std::vector<QPointF> keys(series_.size());
+  QPointF next(area.left() + 8, area.top() + 2);
+  double legend_bottom = area.top();
+  for (std::size_t i = 0; i < series_.size(); ++i) {
+    if (series_[i].label.isEmpty()) continue;
+    const double width = kKey + painter.fontMetrics().horizontalAdvance(series_[i].label);
+    if (next.x() + width > area.right() && next.x() > area.left() + 8) next = QPointF(area.left() + 8, next.y() + kRow);
+    keys[i] = next;
+    next.rx() += width + kGap;
+    legend_bottom = next.y() + kRow;
+  }
   // Inset a little, so that markers at the ends are drawn whole.
-  const QRectF data_area = area.adjusted(5, legend ? 22.0 : 5.0, -5, -5);
+  const QRectF data_area(QPointF(area.left() + 5, std::max(legend_bottom + 2, area.top() + 5)),
+                         QPointF(area.right() - 5, area.bottom() - 5));
   painter.drawText(QRectF(20, data_area.top() - 7, 50, 14), Qt::AlignRight, QString::number(y1, 'g', 4));
   painter.drawText(QRectF(20, data_area.bottom() - 7, 50, 14), Qt::AlignRight, QString::number(y0, 'g', 4));
   painter.drawText(QRectF(area.left(), area.bottom() + 4, 80, 16), Qt::AlignLeft, QString::number(x0, 'g', 4));
@@ -62,8 +80,8 @@ void PlotWidget::paintEvent(QPaintEvent*) {
     return QPointF(data_area.left() + (x - x0) / (x1 - x0) * data_area.width(),
                    data_area.bottom() - (y - y0) / (y1 - y0) * data_area.height());
   };
-  double legend_x = area.left() + 8;
-  for (const Series& s : series_) {
+  for (std::size_t i = 0; i < series_.size(); ++i) {
+    const Series& s = series_[i];
     painter.setPen(QPen(s.colour, 1.5));
     if (s.hollow) {
       painter.setBrush(Qt::NoBrush);
@@ -71,15 +89,14 @@ void PlotWidget::paintEvent(QPaintEvent*) {
       painter.setBrush(s.colour);
     }
     if (!s.label.isEmpty()) {
-      const QPointF key(legend_x + 6, area.top() + 10);
+      const QPointF key = keys[i] + QPointF(8, kRow / 2);
       if (s.points) {
         painter.drawEllipse(key, 3, 3);
       } else {
-        painter.drawLine(key - QPointF(6, 0), key + QPointF(6, 0));
+        painter.drawLine(key - QPointF(7, 0), key + QPointF(7, 0));
       }
-      const double text_width = painter.fontMetrics().horizontalAdvance(s.label);
-      painter.drawText(QRectF(key.x() + 10, area.top() + 2, text_width + 2, 18), Qt::AlignLeft, s.label);
-      legend_x += text_width + 36;
+      painter.drawText(QRectF(keys[i].x() + kKey - 10, keys[i].y(), area.width(), kRow), Qt::AlignLeft | Qt::AlignVCenter,
+                       s.label);
     }
     if (s.points) {
       for (std::size_t i = 0; i < s.x.size(); ++i) painter.drawEllipse(map(s.x[i], s.y[i]), 3, 3);
@@ -185,29 +202,29 @@ void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
 }
 
 void RigPanel::refresh() {
-  auto series = [](const SeriesHistory& h, QColor colour, const char* label) {
+  auto series = [](std::vector<double> x, std::vector<double> y, QColor colour, const char* label) {
     PlotWidget::Series s;
-    s.x.assign(h.times().begin(), h.times().end());
-    s.y.assign(h.values().begin(), h.values().end());
+    s.x = std::move(x);
+    s.y = std::move(y);
     s.colour = colour;
     s.label = label;
     return s;
   };
+  auto history = [&](const SeriesHistory& h, QColor colour, const char* label) {
+    return series({h.times().begin(), h.times().end()}, {h.values().begin(), h.values().end()}, colour, label);
+  };
   loading_plot_->setSeries(
-      {series(shear_, QColor(20, 20, 20), "F_X (stage spring)"), series(normal_, QColor(60, 120, 200), "F_Z")});
-  auto events = [this](EventKind kind, QColor colour, bool hollow, const char* label) {
-    PlotWidget::Series s;
-    s.x = events_.points(kind).shear_ratio;
-    s.y = events_.points(kind).length_ratio;
-    s.colour = colour;
+      {history(shear_, QColor(20, 20, 20), "F_X (stage spring)"), history(normal_, QColor(60, 120, 200), "F_Z")});
+  auto events = [&](EventKind kind, QColor colour, bool hollow, const char* label) {
+    PlotWidget::Series s = series(events_.points(kind).shear_ratio, events_.points(kind).length_ratio, colour, label);
     s.points = true;
     s.hollow = hollow;
-    s.label = label;
     return s;
   };
   const QColor blue(40, 90, 220);
   precursor_plot_->setSeries({events(EventKind::Precursor, blue, false, "precursor"),
                               events(EventKind::SingleNodeSlip, blue, true, "single-node slip (L_p = 0)"),
+                              events(EventKind::AfterGlobal, QColor(150, 150, 150), false, "after a global slip"),
                               events(EventKind::Global, QColor(210, 30, 30), false, "global event")});
   const char* modes[] = {"velocity", "hold", "position"};
   state_label_->setText(QString("stage: t = %1 s, %2, X_s = %3 mm, V = %4 mm/s, F_X = %5 N, F_Z = %6 N, "

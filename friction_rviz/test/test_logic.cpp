@@ -70,15 +70,18 @@ TEST(History, SeriesKeepsAtMostItsCapacityAndClearsWhenTimeJumpsBack) {
   EXPECT_DOUBLE_EQ(history.values().front(), 1.0);
 }
 
-TEST(History, PrecursorPlotTellsSingleNodeSlipsFromPrecursorsAndGlobalEvents) {
+TEST(History, PrecursorPlotTellsSingleNodeSlipsPrecursorsGlobalEventsAndLaterCycles) {
   PrecursorScatter scatter;
   scatter.add(192.0, 1920.0, 0.0, 0.14, false);    // one node alone
   scatter.add(276.0, 1920.0, 0.035, 0.14, false);  // a precursor a quarter of the slider long
-  scatter.add(399.0, 1920.0, 0.14, 0.14, true);
   scatter.add(100.0, 0.0, 0.01, 0.14, false);      // no normal load: no F_X/F_Z to plot
+  scatter.add(399.0, 1920.0, 0.14, 0.14, true);
+  scatter.add(353.0, 1920.0, 0.0875, 0.14, false);  // arrested in the next stick–slip cycle
+  scatter.add(96.0, 1920.0, 0.0, 0.14, false);      // so is a single node after the global slip
   const auto& single = scatter.points(EventKind::SingleNodeSlip);
   const auto& precursors = scatter.points(EventKind::Precursor);
   const auto& global = scatter.points(EventKind::Global);
+  const auto& later = scatter.points(EventKind::AfterGlobal);
   ASSERT_EQ(single.shear_ratio.size(), 1u);
   EXPECT_DOUBLE_EQ(single.shear_ratio[0], 0.1);
   EXPECT_DOUBLE_EQ(single.length_ratio[0], 0.0);
@@ -87,9 +90,15 @@ TEST(History, PrecursorPlotTellsSingleNodeSlipsFromPrecursorsAndGlobalEvents) {
   EXPECT_DOUBLE_EQ(precursors.length_ratio[0], 0.25);
   ASSERT_EQ(global.length_ratio.size(), 1u);
   EXPECT_DOUBLE_EQ(global.length_ratio[0], 1.0);
-  EXPECT_EQ(eventKind(true, 0.0), EventKind::Global);  // a one-node interface's global event
-  scatter.clear();
+  ASSERT_EQ(later.length_ratio.size(), 2u);
+  EXPECT_DOUBLE_EQ(later.shear_ratio[0], 353.0 / 1920.0);
+  EXPECT_DOUBLE_EQ(later.length_ratio[0], 0.625);
+  EXPECT_DOUBLE_EQ(later.length_ratio[1], 0.0);
+  EXPECT_EQ(eventKind(true, 0.0, false), EventKind::Global);  // a one-node interface's global event
+  scatter.clear();  // time jumped back: the next event is before any global one again
   EXPECT_TRUE(scatter.points(EventKind::Global).shear_ratio.empty());
+  scatter.add(276.0, 1920.0, 0.035, 0.14, false);
+  EXPECT_EQ(scatter.points(EventKind::Precursor).shear_ratio.size(), 1u);
 }
 
 TEST(History, SpaceTimeStripOutlinesEventsWithTheirSlippedRange) {

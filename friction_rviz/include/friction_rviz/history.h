@@ -26,12 +26,14 @@ class SeriesHistory {
 };
 
 /// The kinds of slip event the panel's L_p/L against F_X/F_Z plot tells apart.
-enum class EventKind { Precursor = 0, SingleNodeSlip = 1, Global = 2 };
-/// A global event ran over the whole interface; of the others, one with L_p = 0 is a single node slipping
-/// alone (no front ran), as the runner's summary and rig_report count them.
-EventKind eventKind(bool global_event, double rupture_length);
+enum class EventKind { Precursor = 0, SingleNodeSlip = 1, AfterGlobal = 2, Global = 3 };
+/// A global event ran over the whole interface. The others before the first global event are precursors,
+/// and those with L_p = 0 single nodes slipping alone (no front ran), as the runner's summary
+/// (results_io.cpp) and rig_report count them; those after it arrested in a later stick–slip cycle,
+/// on an interface the global slip has left stressed differently.
+EventKind eventKind(bool global_event, double rupture_length, bool after_a_global_event);
 
-/// The points of the precursor plot, (F_X/F_Z at onset, L_p/L), by kind.
+/// The points of the precursor plot, (F_X/F_Z at onset, L_p/L), by kind; events are added in order.
 class PrecursorScatter {
  public:
   struct Points {
@@ -40,11 +42,15 @@ class PrecursorScatter {
   /// Forces in N, lengths in m. An event whose ratios are not finite (F_Z or L zero) adds no point.
   void add(double onset_shear_force, double onset_normal_force, double rupture_length, double slider_length,
            bool global_event);
-  void clear() { points_ = {}; }
+  void clear() {
+    points_ = {};
+    seen_global_ = false;
+  }
   const Points& points(EventKind kind) const { return points_[static_cast<int>(kind)]; }
 
  private:
-  std::array<Points, 3> points_;
+  std::array<Points, 4> points_;
+  bool seen_global_ = false;
 };
 
 /// A slip event as the space–time strip outlines it.
