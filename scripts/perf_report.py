@@ -169,7 +169,8 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
              "## The machine", "",
              "- %s, %s; %d cores used: 1 (every run is single-threaded)" % (platform.processor() or platform.machine(),
                                                                            cpu_model(), os.cpu_count()),
-             "- %s; g++ -O3 -march=native (option FRICTION_SIM_NATIVE)" % platform.platform(), "",
+             "- %s; g++ -O3 -march=native (option FRICTION_SIM_NATIVE)" % platform.platform(),
+             "- measured on %s" % time.strftime("%Y-%m-%d"), "",
              "## Kernels (Google Benchmark, `bench_kernels`)", "",
              "| case | ns per node-step (or block-step): median of 5 | fastest – slowest |", "|---|---|---|"]
     repetitions = {}
@@ -180,7 +181,11 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
     median = {name: statistics.median(values) for name, values in repetitions.items()}
     for name, values in repetitions.items():
         lines.append("| %s | %.2f | %.2f – %.2f |" % (name, median[name], min(values), max(values)))
-    lines += ["", kernels_discussion(median)]
+    stream = repetitions.get("stateStream/1767", [math.nan])
+    lines += ["", "The host is shared and its speed drifts from minute to minute, so the five passes are spread over "
+              "the minutes rather than run in a row. `stateStream/1767`, a plain stream in cache whose cost no change "
+              "to the project's code affects, ranged over %.2f – %.2f ns in them: compare a case with it rather than "
+              "across regenerations." % (min(stream), max(stream)), "", kernels_discussion(median)]
     lines += ["", "## Whole runs: wall time and peak memory", "",
               "Each in a fresh process; wall time includes building the model, the stability limit and the loading "
               "solve.", "", "| run | wall (s) | peak memory (MB) |", "|---|---|---|"]
