@@ -39,6 +39,7 @@ namespace {
 struct Observed {
   std::vector<friction_msgs::SlipEvent> events;
   std::vector<friction_msgs::PrecursorPoint> live_points, replay_points;
+  std::vector<friction_msgs::SlipEvent> live_detector_events, replay_detector_events;
   std::vector<double> clock, load_cell_stamps;
   int gauge_profiles = 0;
   double last_stage_time = 0.0;
@@ -249,6 +250,25 @@ TEST(FullRun, LivePrecursorDetectorAgreesWithTheSimulator) { expectPointsMatchEv
 
 TEST(FullRun, ReplayedBagGivesTheSamePrecursorPoints) { expectPointsMatchEvents(g_seen.replay_points); }
 
+TEST(FullRun, DetectorTakesTheWaveSpeedsFromTheRunsSceneOrLeavesThemUnknown) {
+  // rig.launch gives the live detector the run's scene; the replaying one has none (full_run.test).
+  ASSERT_EQ(g_seen.live_detector_events.size(), g_seen.events.size());
+  for (std::size_t e = 0; e < g_seen.events.size(); ++e) {
+    const auto& detected = g_seen.live_detector_events[e];
+    const auto& simulated = g_seen.events[e];
+    EXPECT_NEAR(detected.shear_wave_speed, 968.2, 0.1);  // MODEL.md §2, the default material
+    EXPECT_EQ(detected.shear_wave_speed, simulated.shear_wave_speed);
+    EXPECT_EQ(detected.rayleigh_speed, simulated.rayleigh_speed);
+    EXPECT_EQ(detected.longitudinal_wave_speed, simulated.longitudinal_wave_speed);
+  }
+  ASSERT_EQ(g_seen.replay_detector_events.size(), g_seen.events.size());
+  for (const auto& detected : g_seen.replay_detector_events) {
+    EXPECT_EQ(detected.shear_wave_speed, 0.0);
+    EXPECT_EQ(detected.rayleigh_speed, 0.0);
+    EXPECT_EQ(detected.longitudinal_wave_speed, 0.0);
+  }
+}
+
 TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
   ros::NodeHandle pnh("~");
   std::string scene_path, protocol_path;
@@ -287,6 +307,8 @@ void watchFullRun(ros::NodeHandle& nh) {
   subs.push_back(listen<friction_msgs::SlipEvent>(nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); }));
   subs.push_back(listen<friction_msgs::PrecursorPoint>(nh, "/rig/precursor_detector/precursor_points", [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.live_points.push_back(*m); }));
   subs.push_back(listen<friction_msgs::PrecursorPoint>(nh, "/replay/precursor_detector/precursor_points", [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.replay_points.push_back(*m); }));
+  subs.push_back(listen<friction_msgs::SlipEvent>(nh, "/rig/precursor_detector/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.live_detector_events.push_back(*m); }));
+  subs.push_back(listen<friction_msgs::SlipEvent>(nh, "/replay/precursor_detector/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.replay_detector_events.push_back(*m); }));
   subs.push_back(listen<rosgraph_msgs::Clock>(nh, "/clock", [](const rosgraph_msgs::Clock::ConstPtr& m) { g_seen.clock.push_back(m->clock.toSec()); }));
   subs.push_back(listen<friction_msgs::StrainGaugeProfile>(nh, "/rig/strain_gauges", [](const friction_msgs::StrainGaugeProfile::ConstPtr&) { ++g_seen.gauge_profiles; }));
   subs.push_back(listen<friction_msgs::StageState>(nh, "/rig/stage_state", [](const friction_msgs::StageState::ConstPtr& m) {

@@ -4,7 +4,9 @@
 #include <cmath>
 
 #include "friction_sim/ros/conversions.h"
+#include "friction_sim/ros/precursor_detector.h"
 #include "friction_sim/ros/rig_simulator.h"
+#include "friction_sim/yaml_fields.h"
 
 namespace friction {
 namespace {
@@ -162,6 +164,44 @@ TEST(SimulatorOptions, EveryBadParameterIsNamedWithValueAndRange) {
   ASSERT_EQ(overrides.size(), 2u);
   EXPECT_EQ(overrides[1].first, "stop.global_events");
   EXPECT_EQ(overrides[1].second, "3");
+}
+
+TEST(DetectorOptions, EveryBadParameterIsNamedWithValueAndRange) {
+  DetectorOptions options;
+  EXPECT_TRUE(validateDetectorOptions(options).empty());
+  options.front_fit_nodes = 1;
+  options.overrides = "material.density=1200 broken";
+  const auto problems = validateDetectorOptions(options);
+  ASSERT_EQ(problems.size(), 3u);
+  EXPECT_NE(problems[0].find("~front_fit_nodes: value 1 is not allowed; allowed: >= 2"), std::string::npos);
+  EXPECT_NE(problems[1].find("~overrides: 'material.density=1200 broken' given without ~scene"), std::string::npos);
+  EXPECT_NE(problems[2].find("~overrides: item 'broken'"), std::string::npos);
+}
+
+TEST(DetectorOptions, TheRunsSceneGivesTheModelsWaveSpeeds) {
+  DetectorOptions options;
+  const WaveSpeeds unknown = detectorWaveSpeeds(options);
+  EXPECT_EQ(unknown.longitudinal, 0.0);
+  EXPECT_EQ(unknown.shear, 0.0);
+  EXPECT_EQ(unknown.rayleigh, 0.0);
+  // MODEL.md §2 with the default numbers: c_S = √(3E/(8ρ)) ≈ 968 m/s, c_L ≈ 1677 m/s, c_R ≈ 0.919·c_S.
+  options.scene_path = SCENE_DIR "/pmma_2d.yaml";
+  const WaveSpeeds lattice = detectorWaveSpeeds(options);
+  EXPECT_NEAR(lattice.shear, 968.2, 0.1);
+  EXPECT_NEAR(lattice.longitudinal, 1677.05, 0.01);
+  EXPECT_NEAR(lattice.rayleigh, 0.919 * lattice.shear, 1e-9);
+  // The run's overrides apply: a quarter of the density doubles every speed.
+  options.overrides = "material.density=300";
+  EXPECT_NEAR(detectorWaveSpeeds(options).shear, 2 * lattice.shear, 1e-9);
+  // The chain has the bar speed √(E/ρ) and no surface wave.
+  options.scene_path = SCENE_DIR "/pmma_1d_side.yaml";
+  options.overrides.clear();
+  const WaveSpeeds chain = detectorWaveSpeeds(options);
+  EXPECT_NEAR(chain.shear, std::sqrt(3.0e9 / 1200.0), 1e-9);
+  EXPECT_EQ(chain.rayleigh, 0.0);
+  // A scene the simulator would refuse is refused here too.
+  options.overrides = "material.density=-1";
+  EXPECT_THROW(detectorWaveSpeeds(options), ConfigError);
 }
 
 }  // namespace

@@ -1,18 +1,43 @@
 #include "friction_sim/ros/precursor_detector.h"
 
 #include "friction_sim/ros/conversions.h"
+#include "friction_sim/ros/rig_simulator.h"
+#include "friction_sim/scene_io.h"
 
 namespace friction {
 
-PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : nh_(std::move(nh)), private_nh_(std::move(private_nh)) {
-  int front_fit_nodes = 5;
-  private_nh_.param("front_fit_nodes", front_fit_nodes, front_fit_nodes);
-  if (front_fit_nodes < 2) {
-    ROS_WARN_STREAM("~front_fit_nodes: value " << front_fit_nodes << " is not allowed; allowed: >= 2; using 5");
-    front_fit_nodes = 5;
+std::vector<std::string> validateDetectorOptions(const DetectorOptions& options) {
+  std::vector<std::string> problems;
+  if (options.front_fit_nodes < 2) {
+    problems.push_back("~front_fit_nodes: value " + std::to_string(options.front_fit_nodes) +
+                       " is not allowed; allowed: >= 2");
   }
-  detector_ = std::make_unique<FrameEventDetector>(front_fit_nodes);
+  if (options.scene_path.empty() && !options.overrides.empty()) {
+    problems.push_back("~overrides: '" + options.overrides + "' given without ~scene; allowed: overrides of a scene");
+  }
+  parseOverrides(options.overrides, problems);
+  return problems;
+}
+
+DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh) {
+  DetectorOptions options;
+  private_nh.param("front_fit_nodes", options.front_fit_nodes, options.front_fit_nodes);
+  private_nh.param("scene", options.scene_path, options.scene_path);
+  private_nh.param("overrides", options.overrides, options.overrides);
+  const auto problems = validateDetectorOptions(options);
+  if (!problems.empty()) throw ConfigError("parameters of " + private_nh.getNamespace(), problems);
+  return options;
+}
+
+WaveSpeeds detectorWaveSpeeds(const DetectorOptions& options) {
+  if (options.scene_path.empty()) return {};
+  std::vector<std::string> ignored;  // validateDetectorOptions has refused malformed overrides
+  return waveSpeeds(loadScene(options.scene_path, parseOverrides(options.overrides, ignored)));
+}
+
+PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private_nh, const DetectorOptions& options)
+    : nh_(std::move(nh)), private_nh_(std::move(private_nh)), wave_speeds_(detectorWaveSpeeds(options)) {
+  detector_ = std::make_unique<FrameEventDetector>(options.front_fit_nodes);
   events_pub_ = private_nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   points_pub_ = private_nh_.advertise<friction_msgs::PrecursorPoint>("precursor_points", 1000, true);
   // Deep queues: a bag played fast must not drop frames, or events would be merged.
@@ -45,7 +70,7 @@ void PrecursorDetector::onFrame(const friction_msgs::InterfaceState::ConstPtr& m
 void PrecursorDetector::publishCompleted() {
   for (const SlipEvent& event : detector_->takeCompletedEvents()) {
     const double length = detector_->sliderLength();
-    events_pub_.publish(toMsg(event, positions_, length, WaveSpeeds{}, "slider"));
+    events_pub_.publish(toMsg(event, positions_, length, wave_speeds_, "slider"));
     points_pub_.publish(toPointMsg(event, length, "slider"));
     ROS_INFO_STREAM("precursor detector: event " << event.index << " F_X/F_Z = "
                                                  << event.onset_shear_force / event.onset_normal_force

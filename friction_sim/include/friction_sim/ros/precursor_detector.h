@@ -4,12 +4,17 @@
 // analysis itself in a ROS-free class (here FrameEventDetector) that you can unit-test.
 //
 // Parameters (private, ~):
-//   front_fit_nodes (int, 5)   nodes in the sliding fit of the front speed
+//   front_fit_nodes (int, 5)   nodes in the sliding fit of the front speed, >= 2
+//   scene (string, "")         the run's scene YAML: its model's wave speeds go into the events, so that
+//                              v_c/c_R and v_c/c_S can be read off them (the instruments do not tell
+//                              them, as a lab takes c_R of its PMMA from the literature); "" = unknown (0)
+//   overrides (string, "")     the run's scene overrides, "key=value key=value", as the simulator's
 // Subscribed topics (relative to the node's namespace):
 //   load_cells (geometry_msgs/WrenchStamped), interface (friction_msgs/InterfaceState)
 // Published topics (private):
 //   ~slip_events (friction_msgs/SlipEvent), ~precursor_points (friction_msgs/PrecursorPoint)
-//   The events' wave speeds are 0 (unknown): the instruments do not tell them.
+//
+// Bad parameters or a refused scene end the node at start (exit status 2), every problem listed.
 //
 // When time jumps backwards (looped playback), it forgets everything and starts over.
 #pragma once
@@ -19,14 +24,30 @@
 #include <ros/ros.h>
 
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "friction_sim/frame_event_detector.h"
+#include "friction_sim/slip_events.h"
 
 namespace friction {
 
+struct DetectorOptions {
+  int front_fit_nodes = 5;  ///< nodes in the sliding linear fit of the front speed v_c(x)
+  std::string scene_path;   ///< the run's scene YAML, for the model's wave speeds; "" = unknown
+  std::string overrides;    ///< "key=value ..." scene fields the run replaced
+};
+
+/// Every problem of the options, each naming the parameter, the value and the allowed range.
+std::vector<std::string> validateDetectorOptions(const DetectorOptions& options);
+/// Reads the options from the private parameters; throws ConfigError listing every problem.
+DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh);
+/// m/s, the wave speeds of the options' scene (all 0 without one); throws ConfigError if it is refused.
+WaveSpeeds detectorWaveSpeeds(const DetectorOptions& options);
+
 class PrecursorDetector {
  public:
-  PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private_nh, const DetectorOptions& options);
 
  private:
   void onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr& msg);
@@ -36,6 +57,7 @@ class PrecursorDetector {
 
   ros::NodeHandle nh_, private_nh_;
   std::unique_ptr<FrameEventDetector> detector_;
+  WaveSpeeds wave_speeds_;
   std::vector<double> positions_;
   ros::Time last_stamp_;
   ros::Subscriber load_cells_sub_, interface_sub_;
