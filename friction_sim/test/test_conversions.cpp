@@ -6,6 +6,7 @@
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/precursor_detector.h"
 #include "friction_sim/ros/rig_simulator.h"
+#include "friction_sim/ros/stage_controller.h"
 #include "friction_sim/yaml_fields.h"
 
 namespace friction {
@@ -164,6 +165,22 @@ TEST(SimulatorOptions, EveryBadParameterIsNamedWithValueAndRange) {
   ASSERT_EQ(overrides.size(), 2u);
   EXPECT_EQ(overrides[1].first, "stop.global_events");
   EXPECT_EQ(overrides[1].second, "3");
+}
+
+TEST(ControllerOptions, EveryBadParameterIsNamedWithValueAndRange) {
+  ControllerOptions options;
+  options.protocol_path = "protocol.yaml";
+  EXPECT_TRUE(validateControllerOptions(options).empty());
+  options.protocol_path.clear();
+  options.start_delay = -0.5;
+  auto problems = validateControllerOptions(options);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].find("~protocol: no value"), std::string::npos);
+  EXPECT_NE(problems[1].find("~start_delay: value -0.5 is not allowed; allowed: >= 0 s"), std::string::npos);
+  options.start_delay = std::nan("");
+  problems = validateControllerOptions(options);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[1].find("~start_delay: value nan"), std::string::npos);
 }
 
 TEST(DetectorOptions, EveryBadParameterIsNamedWithValueAndRange) {

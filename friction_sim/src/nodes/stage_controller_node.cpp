@@ -6,17 +6,11 @@
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "stage_controller");
-  std::string protocol_path;
-  double start_delay = 1.0;
   ros::NodeHandle private_nh("~");
-  private_nh.param<std::string>("protocol", protocol_path, "");
-  private_nh.param("start_delay", start_delay, start_delay);
   try {
-    if (!(start_delay >= 0.0)) {
-      throw friction::ConfigError("parameters of " + private_nh.getNamespace(),
-                                  {"~start_delay: value " + std::to_string(start_delay) + " is not allowed; allowed: >= 0 s"});
-    }
-    friction::StageController controller{ros::NodeHandle(), friction::loadProtocol(protocol_path), start_delay};
+    const friction::ControllerOptions options = friction::readControllerOptions(private_nh);
+    friction::StageController controller{ros::NodeHandle(), friction::loadProtocol(options.protocol_path),
+                                         options.start_delay};
     ros::spin();
   } catch (const friction::ConfigError& error) {
     std::cerr << error.what() << std::endl;

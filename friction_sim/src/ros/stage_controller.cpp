@@ -4,9 +4,33 @@
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 
+#include <cmath>
+#include <sstream>
+
 #include "friction_sim/ros/conversions.h"
+#include "friction_sim/yaml_fields.h"
 
 namespace friction {
+
+std::vector<std::string> validateControllerOptions(const ControllerOptions& options) {
+  std::vector<std::string> problems;
+  if (options.protocol_path.empty()) problems.push_back("~protocol: no value; allowed: the path of a protocol YAML file");
+  if (!(std::isfinite(options.start_delay) && options.start_delay >= 0.0)) {
+    std::ostringstream text;
+    text << "~start_delay: value " << options.start_delay << " is not allowed; allowed: >= 0 s";
+    problems.push_back(text.str());
+  }
+  return problems;
+}
+
+ControllerOptions readControllerOptions(const ros::NodeHandle& private_nh) {
+  ControllerOptions options;
+  private_nh.param("protocol", options.protocol_path, options.protocol_path);
+  private_nh.param("start_delay", options.start_delay, options.start_delay);
+  const auto problems = validateControllerOptions(options);
+  if (!problems.empty()) throw ConfigError("parameters of " + private_nh.getNamespace(), problems);
+  return options;
+}
 
 bool stopSimulator(ros::NodeHandle& nh, ros::WallDuration wait) {
   ros::ServiceClient client = nh.serviceClient<std_srvs::Trigger>("stop");

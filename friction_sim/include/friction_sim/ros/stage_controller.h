@@ -22,9 +22,24 @@
 #include <friction_msgs/StageState.h>
 #include <ros/ros.h>
 
+#include <string>
+#include <vector>
+
 #include "friction_sim/loading_protocol.h"
 
 namespace friction {
+
+struct ControllerOptions {
+  std::string protocol_path;  ///< path of the protocol YAML
+  /// s of wall time to wait before starting a simulator that waits paused (analysis nodes and recorders
+  /// connect meanwhile)
+  double start_delay = 1.0;
+};
+
+/// Every problem of the options, each naming the parameter, the value and the allowed range.
+std::vector<std::string> validateControllerOptions(const ControllerOptions& options);
+/// Reads the options from the private parameters; throws ConfigError listing every problem.
+ControllerOptions readControllerOptions(const ros::NodeHandle& private_nh);
 
 /// Asks the simulator in `nh`'s namespace to end its run, waiting up to `wait` for its stop service;
 /// false if the service did not appear or the call failed.
