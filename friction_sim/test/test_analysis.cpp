@@ -91,16 +91,52 @@ TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
   double low = 0.5, high = 0.99;
   for (int i = 0; i < 60; ++i) (rayleigh(0.5 * (low + high)) < 0 ? low : high) = 0.5 * (low + high);
   EXPECT_NEAR(c.rayleigh / c.shear, low, 1e-3);
-  const FrontSpeedSummary summary = summarizeFrontSpeeds(v_c, c.longitudinal);
-  EXPECT_EQ(summary.faster_than_longitudinal, 2);  // inf and 2000 m/s
+  // The median is the running front's: the patch (nodes 0–2, which unstuck first) and the fits whose
+  // five-node window reaches into it (nodes 3 and 4) are left out.
+  const FrontSpeedSummary summary = summarizeFrontSpeeds(v_c, first_unstick, 5, c.longitudinal);
+  EXPECT_EQ(summary.left_out, 5);
   EXPECT_NEAR(summary.median, speed, 1e-9);
-  // An even count takes the mean of the middle two; an unknown c_L (0) leaves out the infinite fit only.
-  EXPECT_NEAR(summarizeFrontSpeeds({600.0, 750.0, 1200.0, 1500.0}, c.longitudinal).median, 975.0, 1e-9);
-  const FrontSpeedSummary unknown = summarizeFrontSpeeds(v_c, 0.0);
-  EXPECT_EQ(unknown.faster_than_longitudinal, 1);
+  // With c_L unknown (0) the patch is the same here: its nodes unstuck at the same time.
+  const FrontSpeedSummary unknown = summarizeFrontSpeeds(v_c, first_unstick, 5, 0.0);
+  EXPECT_EQ(unknown.left_out, 5);
   EXPECT_NEAR(unknown.median, speed, 1e-9);
-  EXPECT_NEAR(summarizeFrontSpeeds({600.0, 700.0, 2000.0, std::numeric_limits<double>::infinity()}, 0.0).median,
-              700.0, 1e-9);
+
+  // A short precursor, arresting after node 5. Its fits next to the patch read fast but below c_L (1200
+  // and 750 m/s): leaving out only fits above c_L would give a median of 675 m/s, not the front's 600.
+  std::vector<double> short_unstick = first_unstick;
+  std::fill(short_unstick.begin() + 6, short_unstick.end(), std::nan(""));
+  const std::vector<double> short_v_c = frontSpeeds(positions, short_unstick, 5);
+  EXPECT_NEAR(short_v_c[2], 1200.0, 1e-9);
+  EXPECT_NEAR(short_v_c[3], 750.0, 1e-9);
+  const FrontSpeedSummary short_front = summarizeFrontSpeeds(short_v_c, short_unstick, 5, c.longitudinal);
+  EXPECT_EQ(short_front.left_out, 5);
+  EXPECT_NEAR(short_front.median, speed, 1e-9);
+
+  // The patch grows from the node that unstuck first through neighbours whose fits beat c_L: here nodes
+  // 1 and 2 follow node 0 within nanoseconds, and node 1's fit beats c_L (node 2's window reaches the
+  // running front and reads 1200 m/s again). The patch is nodes 0–1; their window, through node 3.
+  std::vector<double> staggered = first_unstick;
+  staggered[1] = 1e-9;
+  staggered[2] = 2e-9;
+  for (int node = 3; node <= 10; ++node) staggered[node] += 2e-9;
+  const std::vector<double> staggered_v_c = frontSpeeds(positions, staggered, 5);
+  EXPECT_GT(staggered_v_c[1], c.longitudinal);
+  EXPECT_NEAR(staggered_v_c[2], 1200.0, 1.0);
+  const FrontSpeedSummary staggered_front = summarizeFrontSpeeds(staggered_v_c, staggered, 5, c.longitudinal);
+  EXPECT_EQ(staggered_front.left_out, 4);
+  EXPECT_NEAR(staggered_front.median, speed, 1e-6);
+
+  // Away from the patch only fits above c_L are left out (with c_L unknown, infinite ones); an even
+  // count takes the mean of the middle two.
+  const double infinity = std::numeric_limits<double>::infinity();
+  const std::vector<double> times{0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0};
+  const std::vector<double> fits{500.0, 500.0, 500.0, 600.0, 750.0, 1200.0, 1500.0, 5000.0, infinity};
+  const FrontSpeedSummary elsewhere = summarizeFrontSpeeds(fits, times, 5, c.longitudinal);
+  EXPECT_EQ(elsewhere.left_out, 5);  // nodes 0–2 (the patch, node 0, and its window), 5000 m/s and inf
+  EXPECT_NEAR(elsewhere.median, 975.0, 1e-9);
+  const FrontSpeedSummary elsewhere_unknown = summarizeFrontSpeeds(fits, times, 5, 0.0);
+  EXPECT_EQ(elsewhere_unknown.left_out, 4);
+  EXPECT_NEAR(elsewhere_unknown.median, 1200.0, 1e-9);
 
   // An even window is as long as asked: two nodes are the difference from the node behind.
   const std::vector<double> pairs = frontSpeeds(positions, first_unstick, 2);
@@ -111,9 +147,10 @@ TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
   EXPECT_TRUE(std::isnan(pairs[11]));
 
   // All together: no front ran, so no median.
-  const FrontSpeedSummary together = summarizeFrontSpeeds(frontSpeeds(positions, std::vector<double>(12, 0.0), 5),
-                                                          c.longitudinal);
-  EXPECT_EQ(together.faster_than_longitudinal, 12);
+  const std::vector<double> all_at_once(12, 0.0);
+  const FrontSpeedSummary together =
+      summarizeFrontSpeeds(frontSpeeds(positions, all_at_once, 5), all_at_once, 5, c.longitudinal);
+  EXPECT_EQ(together.left_out, 12);
   EXPECT_TRUE(std::isnan(together.median));
 }
 
@@ -154,7 +191,8 @@ void expectTheSameEventsAndExtents(const std::vector<SlipEvent>& found, const st
 
 TEST(FrameEventDetector, FindsTheSimulatorsEventsFromTheInstrumentsAlone) {
   Simulation simulation(loadScene(testing::scenePath("pmma_1d_side")));
-  FrameEventDetector detector(simulation.scene().instruments.front_fit_nodes);
+  FrameEventDetector detector(simulation.scene().instruments.front_fit_nodes,
+                              waveSpeeds(simulation.scene()).longitudinal);
   const std::vector<SlipEvent> found = eventsSeenByTheInstruments(simulation, detector);
   EXPECT_DOUBLE_EQ(detector.sliderLength(), simulation.scene().geometry.length);
   const auto& truth = simulation.events();
@@ -179,7 +217,7 @@ TEST(FrameEventDetector, StuckNodesMovingOnTheirInterfacialSpringsDidNotSlip) {
   Scene scene = loadScene(testing::scenePath("pmma_1d_side"));
   scene.friction.interfacial_stiffness = 1.0e8;
   Simulation simulation(scene);
-  FrameEventDetector detector(scene.instruments.front_fit_nodes);
+  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal);
   const std::vector<SlipEvent> found = eventsSeenByTheInstruments(simulation, detector);
   const auto& truth = simulation.events();
   expectTheSameEventsAndExtents(found, truth);

@@ -68,6 +68,8 @@ TEST(Conversions, SlipEventCarriesEveryQuantity) {
   event.node_slip = {1e-6, 5e-7, 0.0};
   event.first_unstick_time = {0.1, 0.10001, std::nan("")};
   event.front_speed = {250.0, 250.0, std::nan("")};
+  event.median_front_speed = 250.0;
+  event.front_fits_left_out = 1;
   const auto msg = toMsg(event, {0.0, 0.0025, 0.005}, 0.14, WaveSpeeds{1677.0, 968.0, 890.0}, "slider");
   EXPECT_EQ(msg.header.stamp, ros::Time(0.1004));
   EXPECT_DOUBLE_EQ(msg.slider_length, 0.14);
@@ -81,6 +83,8 @@ TEST(Conversions, SlipEventCarriesEveryQuantity) {
   EXPECT_DOUBLE_EQ(back.rupture_length, 0.05);
   EXPECT_EQ(back.node_slip, event.node_slip);
   EXPECT_TRUE(std::isnan(back.first_unstick_time[2]));
+  EXPECT_DOUBLE_EQ(back.median_front_speed, 250.0);
+  EXPECT_EQ(back.front_fits_left_out, 1);
   const auto point = toPointMsg(event, 0.14, "slider");
   EXPECT_DOUBLE_EQ(point.shear_ratio, 200.0 / 1920.0);
   EXPECT_DOUBLE_EQ(point.length_ratio, 0.05 / 0.14);

@@ -18,8 +18,9 @@ namespace friction {
 
 class FrameEventDetector {
  public:
-  /// `front_fit_nodes` as in the scene.
-  explicit FrameEventDetector(int front_fit_nodes);
+  /// `front_fit_nodes` as in the scene; `longitudinal_speed` (m/s, c_L; ≤ 0 unknown) for the events'
+  /// median front speed (summarizeFrontSpeeds).
+  FrameEventDetector(int front_fit_nodes, double longitudinal_speed);
 
   /// Load-cell samples, in time order.
   void addLoadCells(const LoadCellReading& reading);
@@ -37,6 +38,7 @@ class FrameEventDetector {
 
  private:
   int front_fit_nodes_;
+  double longitudinal_speed_;
   double slider_length_ = 0.0;
   double last_frame_time_ = -std::numeric_limits<double>::infinity();
   int next_index_ = 0;

@@ -25,11 +25,14 @@ struct SlipEvent {
   std::vector<double> node_slip;    ///< m, per interface node, displacement during the event
   std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
   std::vector<double> front_speed;  ///< m/s, v_c per node from the first-unstick times; NaN where undefined
+  double median_front_speed = 0.0;  ///< m/s, the event's front speed in one number (summarizeFrontSpeeds)
+  int front_fits_left_out = 0;      ///< fits left out of that median (summarizeFrontSpeeds)
 };
 
 class SlipEventDetector {
  public:
-  SlipEventDetector(const Model& model, int front_fit_nodes);
+  /// `longitudinal_speed` (m/s, c_L) for the events' median front speed (summarizeFrontSpeeds).
+  SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed);
 
   /// The load cells over the step just taken: F_X at its start and end, F_Z.
   struct StepLoads {
@@ -51,6 +54,7 @@ class SlipEventDetector {
   std::vector<double> positions_;
   std::vector<int> dofs_;
   int fit_nodes_;
+  double longitudinal_speed_;
   bool in_event_ = false;
   SlipEvent current_;
   std::vector<double> onset_u_;
@@ -58,9 +62,18 @@ class SlipEventDetector {
   int global_count_ = 0;
 };
 
+/// The nodes of a front-speed fit of `fit_nodes` nodes centred on a node: as many at lower x as at
+/// higher, one more at lower x when even (for a front from the trailing edge, the nodes it has
+/// crossed: the last node before an arrest has a speed).
+struct FitWindow {
+  int behind;  ///< nodes at lower x
+  int ahead;   ///< nodes at higher x
+};
+FitWindow frontFitWindow(int fit_nodes);
+
 /// m/s, front speed per node from first-unstick times t(x) (NaN = not slipped): a linear fit of t against
-/// x over `fit_nodes` consecutive slipped nodes centred on each node (one more at lower x when
-/// even; fewer at the ends and at unslipped gaps); v_c = 1/|dt/dx| (inf if simultaneous).
+/// x over the slipped nodes of the node's frontFitWindow (fewer at the ends and at unslipped gaps);
+/// v_c = 1/|dt/dx| (inf if simultaneous).
 std::vector<double> frontSpeeds(const std::vector<double>& positions,
                                 const std::vector<double>& first_unstick_time, int fit_nodes);
 
@@ -74,17 +87,24 @@ struct WaveSpeeds {
 };
 WaveSpeeds waveSpeeds(const Scene& scene);
 
-/// An event's front speed in one number.
+/// An event's front speed in one number: the speed of the front that ran, not of the nucleation.
 struct FrontSpeedSummary {
-  /// m/s, median v_c over the nodes whose fit is finite and at most c_L (the mean of the middle two
-  /// for an even count); NaN if there are none. Fits just below c_L next to a nucleation patch stay in.
+  /// m/s, median v_c over the fits of a running front (the mean of the middle two for an even count);
+  /// NaN if there are none
   double median = 0.0;
-  /// nodes whose fit is faster than c_L or infinite: they unstuck too nearly together for a running
-  /// front, as where the pusher's load fails several nodes at once; left out of the median
-  int faster_than_longitudinal = 0;
+  /// fits left out of the median. A fit faster than c_L (or infinite) is of nodes that unstuck too nearly
+  /// together for a running front, as where the pusher's load fails several nodes at once. Around the
+  /// nucleation those nodes form a patch: from the node(s) that unstuck first, through the neighbours
+  /// whose fits are that fast. Left out are the patch, every fit whose window reaches into it (its
+  /// slope mixes the patch's near-simultaneous times with the front's, so it reads fast, yet may stay
+  /// below c_L) and any other fit faster than c_L.
+  int left_out = 0;
 };
-/// `longitudinal_speed` ≤ 0 means unknown (an analysis node without the scene): then only infinite
-/// fits are left out.
-FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed, double longitudinal_speed);
+/// From an event's per-node front_speed and first_unstick_time (NaN where not slipped), fitted over
+/// `fit_nodes` nodes. `longitudinal_speed` ≤ 0 means unknown (an analysis node without the scene): then
+/// only infinite fits count as too fast.
+FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
+                                       const std::vector<double>& first_unstick_time, int fit_nodes,
+                                       double longitudinal_speed);
 
 }  // namespace friction

@@ -13,7 +13,8 @@ bool anySliding(const InterfaceFrame& frame) {
 }
 }  // namespace
 
-FrameEventDetector::FrameEventDetector(int front_fit_nodes) : front_fit_nodes_(front_fit_nodes) {}
+FrameEventDetector::FrameEventDetector(int front_fit_nodes, double longitudinal_speed)
+    : front_fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed) {}
 
 void FrameEventDetector::reset() {
   next_index_ = 0;
@@ -107,6 +108,10 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   event.rupture_length = slipped ? x_max - x_min : 0.0;
   event.global = slipped == n;
   event.front_speed = frontSpeeds(frame.position, event.first_unstick_time, front_fit_nodes_);
+  const FrontSpeedSummary front =
+      summarizeFrontSpeeds(event.front_speed, event.first_unstick_time, front_fit_nodes_, longitudinal_speed_);
+  event.median_front_speed = front.median;
+  event.front_fits_left_out = front.left_out;
   last_stuck_frame_ = frame;
   ended_.push_back(std::move(event));
 }

@@ -10,7 +10,8 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
-SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes) : fit_nodes_(front_fit_nodes) {
+SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed)
+    : fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed) {
   for (int node = 0; node < model.interfaceNodeCount(); ++node) {
     positions_.push_back(model.interfacePosition(node));
     dofs_.push_back(model.interfaceDof(node));
@@ -75,17 +76,24 @@ void SlipEventDetector::finish(double end_time, const Vector& u, double end_shea
   event.rupture_length = x_max - x_min;
   event.global = slipped == n;
   event.front_speed = frontSpeeds(positions_, event.first_unstick_time, fit_nodes_);
+  const FrontSpeedSummary front = summarizeFrontSpeeds(event.front_speed, event.first_unstick_time, fit_nodes_,
+                                                       longitudinal_speed_);
+  event.median_front_speed = front.median;
+  event.front_fits_left_out = front.left_out;
   if (event.global) ++global_count_;
   events_.push_back(std::move(event));
+}
+
+FitWindow frontFitWindow(int fit_nodes) {
+  const int nodes = std::max(fit_nodes, 2);
+  return {nodes / 2, (nodes - 1) / 2};
 }
 
 std::vector<double> frontSpeeds(const std::vector<double>& positions,
                                 const std::vector<double>& first_unstick_time, int fit_nodes) {
   const int n = static_cast<int>(positions.size());
   std::vector<double> speed(n, kNaN);
-  // A window of fit_nodes nodes: as many at lower x as at higher, one more at lower x when even (for a
-  // front from the trailing edge, the nodes it has crossed: the last node before an arrest has a speed).
-  const int behind = std::max(fit_nodes, 2) / 2, ahead = (std::max(fit_nodes, 2) - 1) / 2;
+  const auto [behind, ahead] = frontFitWindow(fit_nodes);
   for (int centre = 0; centre < n; ++centre) {
     if (std::isnan(first_unstick_time[centre])) continue;
     // Fit over the slipped nodes of the window around the centre, not across unslipped gaps.
@@ -125,16 +133,39 @@ WaveSpeeds waveSpeeds(const Scene& scene) {
   return {std::sqrt(3.0) * shear, shear, kRayleighFraction * shear};
 }
 
-FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed, double longitudinal_speed) {
+FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
+                                       const std::vector<double>& first_unstick_time, int fit_nodes,
+                                       double longitudinal_speed) {
   FrontSpeedSummary summary;
+  const int n = static_cast<int>(front_speed.size());
   const bool limit_known = longitudinal_speed > 0.0;
+  auto too_fast = [&](int node) {
+    const double speed = front_speed[node];
+    return !std::isnan(speed) && (!std::isfinite(speed) || (limit_known && speed > longitudinal_speed));
+  };
+  // The patch: the node(s) that unstuck first, grown through neighbours whose fits are too fast.
+  double first_time = std::numeric_limits<double>::infinity();
+  for (double time : first_unstick_time) {
+    if (!std::isnan(time)) first_time = std::min(first_time, time);
+  }
+  int patch_low = n, patch_high = -1;
+  for (int node = 0; node < n; ++node) {
+    if (first_unstick_time[node] != first_time) continue;
+    patch_low = std::min(patch_low, node);
+    patch_high = node;
+  }
+  while (patch_low > 0 && patch_low <= patch_high && too_fast(patch_low - 1)) --patch_low;
+  while (patch_high >= 0 && patch_high + 1 < n && too_fast(patch_high + 1)) ++patch_high;
+  // A node's window [node − behind, node + ahead] reaches into [patch_low, patch_high].
+  const FitWindow window = frontFitWindow(fit_nodes);
+  auto near_patch = [&](int node) { return node >= patch_low - window.ahead && node <= patch_high + window.behind; };
   std::vector<double> running;
-  for (double speed : front_speed) {
-    if (std::isnan(speed)) continue;
-    if (std::isfinite(speed) && (!limit_known || speed <= longitudinal_speed)) {
-      running.push_back(speed);
+  for (int node = 0; node < n; ++node) {
+    if (std::isnan(front_speed[node])) continue;
+    if (near_patch(node) || too_fast(node)) {
+      ++summary.left_out;
     } else {
-      ++summary.faster_than_longitudinal;
+      running.push_back(front_speed[node]);
     }
   }
   if (running.empty()) {

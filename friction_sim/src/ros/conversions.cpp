@@ -90,6 +90,8 @@ friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>
   msg.node_slip = event.node_slip;
   msg.first_unstick_time = event.first_unstick_time;
   msg.front_speed = event.front_speed;
+  msg.median_front_speed = event.median_front_speed;
+  msg.front_fits_left_out = static_cast<std::uint32_t>(event.front_fits_left_out);
   msg.rayleigh_speed = speeds.rayleigh;
   msg.shear_wave_speed = speeds.shear;
   msg.longitudinal_wave_speed = speeds.longitudinal;
@@ -112,6 +114,8 @@ SlipEvent fromMsg(const friction_msgs::SlipEvent& msg) {
   event.node_slip = msg.node_slip;
   event.first_unstick_time = msg.first_unstick_time;
   event.front_speed = msg.front_speed;
+  event.median_front_speed = msg.median_front_speed;
+  event.front_fits_left_out = static_cast<int>(msg.front_fits_left_out);
   return event;
 }
 

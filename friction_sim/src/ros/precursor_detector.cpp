@@ -37,7 +37,7 @@ WaveSpeeds detectorWaveSpeeds(const DetectorOptions& options) {
 
 PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private_nh, const DetectorOptions& options)
     : nh_(std::move(nh)), private_nh_(std::move(private_nh)), wave_speeds_(detectorWaveSpeeds(options)) {
-  detector_ = std::make_unique<FrameEventDetector>(options.front_fit_nodes);
+  detector_ = std::make_unique<FrameEventDetector>(options.front_fit_nodes, wave_speeds_.longitudinal);
   events_pub_ = private_nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   points_pub_ = private_nh_.advertise<friction_msgs::PrecursorPoint>("precursor_points", 1000, true);
   // Deep queues: a bag played fast must not drop frames, or events would be merged.
