@@ -122,7 +122,9 @@ RigPanel::RigPanel(QWidget* parent) : rviz::Panel(parent) {
   namespace_edit_ = new QLineEdit("/rig");
   top->addWidget(namespace_edit_);
   layout->addLayout(top);
-  loading_plot_ = new PlotWidget("t (s)", "F_X, F_Z (N)");
+  // F_X alone: on F_Z's scale (1920 N by default) the stick-slip would be a flat line. F_Z is in the
+  // stage line below.
+  loading_plot_ = new PlotWidget("t (s)", "F_X (N)");
   precursor_plot_ = new PlotWidget("F_X / F_Z", "L_p / L");
   layout->addWidget(loading_plot_);
   layout->addWidget(precursor_plot_);
@@ -177,19 +179,13 @@ void RigPanel::connectToRig() {
   command_client_ = rig.serviceClient<friction_msgs::SendStageCommand>("send_command");
   pause_client_ = rig.serviceClient<std_srvs::SetBool>("pause");
   shear_.clear();
-  normal_.clear();
   events_.clear();
   Q_EMIT configChanged();
 }
 
 void RigPanel::onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
   const double t = msg->header.stamp.toSec();
-  if (shear_.add(t, msg->wrench.force.x)) {
-    // Time jumped back (looped playback or a reset): the panel starts over.
-    normal_.clear();
-    events_.clear();
-  }
-  normal_.add(t, msg->wrench.force.z);
+  if (shear_.add(t, msg->wrench.force.x)) events_.clear();  // time jumped back (looped playback or a reset)
 }
 
 void RigPanel::onEvent(const friction_msgs::SlipEvent::ConstPtr& msg) {
@@ -213,8 +209,7 @@ void RigPanel::refresh() {
   auto history = [&](const SeriesHistory& h, QColor colour, const char* label) {
     return series({h.times().begin(), h.times().end()}, {h.values().begin(), h.values().end()}, colour, label);
   };
-  loading_plot_->setSeries(
-      {history(shear_, QColor(20, 20, 20), "F_X (stage spring)"), history(normal_, QColor(60, 120, 200), "F_Z")});
+  loading_plot_->setSeries({history(shear_, QColor(20, 20, 20), "F_X (stage spring)")});
   auto events = [&](EventKind kind, QColor colour, bool hollow, const char* label) {
     PlotWidget::Series s = series(events_.points(kind).shear_ratio, events_.points(kind).length_ratio, colour, label);
     s.points = true;

@@ -1,4 +1,4 @@
-// rviz panel of the rig: the loading curve F_X(t) and F_Z(t) as it comes in, the precursors'
+// rviz panel of the rig: the loading curve F_X(t) as it comes in (F_Z in the stage line), the precursors'
 // L_p/L against F_X/F_Z, the stage state, and buttons that send stage commands through the
 // simulator's send_command service, showing its reply (and the reason for a refusal).
 //
@@ -76,7 +76,7 @@ class RigPanel : public rviz::Panel {
   QDoubleSpinBox *speed_, *target_, *normal_load_;
   QLabel *state_label_, *reply_label_;
   PlotWidget *loading_plot_, *precursor_plot_;
-  SeriesHistory shear_{20000}, normal_{20000};
+  SeriesHistory shear_{20000};
   PrecursorScatter events_;
   friction_msgs::StageState last_state_;
 };
