@@ -8,5 +8,6 @@ set +u; source "$RIG_WS/devel/setup.bash"; set -u
 port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI="http://127.0.0.1:$port" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1
 export ROS_HOME="${ROS_HOME:-$RIG_WS/ros_home}"
-echo "rig_launch: private master at $ROS_MASTER_URI"
+echo "rig_launch: private master at $ROS_MASTER_URI; to reach it from another shell:"
+echo "  source $RIG_WS/devel/setup.bash; export ROS_MASTER_URI=$ROS_MASTER_URI ROS_IP=127.0.0.1"
 exec roslaunch --port "$port" "$@"

@@ -11,7 +11,8 @@ echo "building (log in .build.log) ..."
 source "$here/scripts/ros_env.sh"
 out="$RIG_ROOT/results/experiment"
 mkdir -p "$out"
-rm -f "$out/run.bag"
+# Nothing of an earlier run may pass for this one's if this run fails.
+rm -f "$out"/{run.bag,events.csv,loading_curve.png,precursors.png,slip_map.png}
 "$RIG_ROOT/scripts/rig_launch.sh" "$RIG_ROOT/launch/rig.launch" record:=true bag:="$out/run.bag" "$@" \
   2>&1 | grep -vE '^\s*$|killing on exit|shutting down|^\S*\[1m|REQUIRED process|process has finished|log file:|Initiating shutdown|^=+|SUMMARY|PARAMETERS|NODES|auto-starting|^ \* |^    ' || true
 [ -f "$out/run.bag" ] || { echo "run_experiment: no bag was written" >&2; exit 1; }

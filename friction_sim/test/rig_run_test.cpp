@@ -20,6 +20,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <rosgraph_msgs/Clock.h>
+#include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 
 #include <algorithm>
@@ -52,6 +53,8 @@ struct Observed {
   std::string bad_scene_output, bad_parameter_output, bad_protocol_output;
   int bad_scene_status = 0, bad_parameter_status = 0, bad_protocol_status = 0;
   int stops_after_bad_protocol = 0;
+  std::string refused_command_output;
+  int refused_command_status = 0, stops_after_refused_command = 0, unpauses_after_refused_command = 0;
 };
 Observed g_seen;
 std::string g_bag;
@@ -102,6 +105,47 @@ void runRefusedProtocol() {
   g_seen.bad_protocol_status = runCommand(
       "rosrun friction_sim stage_controller __name:=controller __ns:=/refused_protocol _protocol:=" + protocol,
       g_seen.bad_protocol_output);
+  spinner.stop();
+}
+
+/// A controller whose simulator refuses every command: a stand-in in a namespace of its own that
+/// announces t = 0, refuses what it is sent and counts the calls to stop and to unpause.
+void runProtocolAgainstARefusingSimulator(const std::string& protocol) {
+  ros::CallbackQueue queue;
+  ros::NodeHandle nh("/refused_command");
+  nh.setCallbackQueue(&queue);
+  const boost::function<bool(friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response&)>
+      refuse = [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
+        response.accepted = false;
+        response.reason = "speed 2 m/s exceeds the stage's max_speed 1 m/s";
+        return true;
+      };
+  const boost::function<bool(std_srvs::Trigger::Request&, std_srvs::Trigger::Response&)> count_stops =
+      [](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+        ++g_seen.stops_after_refused_command;
+        response.success = true;
+        return true;
+      };
+  const boost::function<bool(std_srvs::SetBool::Request&, std_srvs::SetBool::Response&)> count_unpauses =
+      [](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
+        if (!request.data) ++g_seen.unpauses_after_refused_command;
+        response.success = true;
+        return true;
+      };
+  ros::ServiceServer commands = nh.advertiseService("send_command", refuse);
+  ros::ServiceServer stop = nh.advertiseService("stop", count_stops);
+  ros::ServiceServer pause = nh.advertiseService("pause", count_unpauses);
+  ros::Publisher state = nh.advertise<friction_msgs::StageState>("stage_state", 1, true);
+  friction_msgs::StageState waiting;
+  waiting.normal_force = 1920.0;
+  waiting.paused = true;
+  state.publish(waiting);
+  ros::AsyncSpinner spinner(1, &queue);
+  spinner.start();
+  g_seen.refused_command_status = runCommand(
+      "rosrun friction_sim stage_controller __name:=controller __ns:=/refused_command _start_delay:=0 _protocol:=" +
+          protocol,
+      g_seen.refused_command_output);
   spinner.stop();
 }
 
@@ -227,6 +271,13 @@ TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
   EXPECT_NE(g_seen.bad_protocol_output.find("protocol refused (2 problems)"), std::string::npos)
       << g_seen.bad_protocol_output;
   EXPECT_EQ(g_seen.stops_after_bad_protocol, 1);
+  // A protocol the simulator refuses a command of is not run under what the simulator had before: the
+  // controller stops it without unpausing it, and exits with status 2.
+  EXPECT_EQ(g_seen.refused_command_status, 2) << g_seen.refused_command_output;
+  EXPECT_NE(g_seen.refused_command_output.find("refused: speed 2 m/s exceeds the stage's max_speed"), std::string::npos)
+      << g_seen.refused_command_output;
+  EXPECT_EQ(g_seen.stops_after_refused_command, 1);
+  EXPECT_EQ(g_seen.unpauses_after_refused_command, 0);
 }
 
 TEST(FullRun, BagHoldsEverySlipEventAndEveryInterfaceFrame) {
@@ -284,9 +335,10 @@ TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
     }
     offline.step();
   }
-  // The controller ends the protocol by calling the simulator's stop service when it sees the second
-  // global event; a loaded machine lets the live run step on meanwhile, so it may hold more events.
-  ASSERT_GE(g_seen.events.size(), offline.events().size());
+  // The simulator ends the run itself on the step of the protocol's end (set_run_end), however late the
+  // controller hears of it: the live run holds the same events and ends at the same step.
+  ASSERT_EQ(g_seen.events.size(), offline.events().size());
+  EXPECT_NEAR(g_seen.last_stage_time, offline.time(), 1e-9);  // a stamp keeps nanoseconds
   for (std::size_t e = 0; e < offline.events().size(); ++e) {
     EXPECT_EQ(offline.events()[e].onset_time, g_seen.events[e].onset_time);
     EXPECT_EQ(offline.events()[e].onset_shear_force, g_seen.events[e].onset_shear_force);
@@ -349,6 +401,11 @@ void watchFullRun(ros::NodeHandle& nh) {
       "rosrun friction_sim rig_simulator __name:=bad_parameter _load_cell_rate:=-1.0 _scene:=" + scene,
       g_seen.bad_parameter_output);
   runRefusedProtocol();
+  {
+    std::string protocol;
+    pnh.getParam("protocol", protocol);
+    runProtocolAgainstARefusingSimulator(protocol);
+  }
   // The controller ends the run after two global events; the simulator then closes its bag.
   waitFor([] { return bagReadable(g_bag); }, 240.0);
   waitFor([] { return g_seen.live_points.size() >= g_seen.events.size(); }, 10.0);

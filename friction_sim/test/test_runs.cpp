@@ -171,6 +171,40 @@ TEST(Determinism, SameSceneTwiceGivesIdenticalEventsAndState) {
   }
 }
 
+TEST(Determinism, AStopConditionSetDuringTheRunEndsItOnTheSameStepAsTheScenes) {
+  // A controller's end (set_run_end) replaces the scene's stop: the run ends on the step where it is
+  // reached, as if the scene had said so; where the scene's own stop was already past, it runs on.
+  Scene scene = loadScene(scenePath("pmma_1d_side"));
+  scene.stop.global_events = 2;
+  Simulation planned(scene);
+  planned.run();
+  scene.stop.global_events = 1;
+  Simulation changed(scene);
+  changed.run();
+  ASSERT_EQ(changed.globalEventCount(), 1);
+  StopSpec later = scene.stop;
+  later.global_events = 2;
+  EXPECT_EQ(changed.setStopCondition(later), "");
+  EXPECT_FALSE(changed.finished());
+  changed.run();
+  EXPECT_EQ(changed.globalEventCount(), 2);
+  EXPECT_EQ(changed.stopReason(), "reached 2 global slip event(s)");
+  EXPECT_EQ(changed.time(), planned.time());
+  EXPECT_EQ(changed.stateHash(), planned.stateHash());
+  // Refused, and the condition unchanged.
+  StopSpec bad = later;
+  bad.global_events = -1;
+  EXPECT_NE(changed.setStopCondition(bad).find("global_events -1 is not allowed"), std::string::npos);
+  bad = later;
+  bad.time = std::nan("");
+  EXPECT_NE(changed.setStopCondition(bad).find("time nan s is not allowed"), std::string::npos);
+  bad = later;
+  bad.stage_travel = 0.0;
+  EXPECT_NE(changed.setStopCondition(bad).find("stage_travel 0 m is not allowed"), std::string::npos);
+  EXPECT_EQ(changed.scene().stop.global_events, 2);
+  EXPECT_TRUE(changed.finished());
+}
+
 TEST(StageProgram, HoldThenDriveThenMoveToATarget) {
   StageSpec spec;
   spec.program = {StageSegment{StageMode::Hold, 0.0, 0.0, 0.01}, StageSegment{StageMode::Velocity, 1e-3, 0.0, 0.01},

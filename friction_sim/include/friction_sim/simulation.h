@@ -87,6 +87,10 @@ class Simulation : public Dynamics {
   /// Why F_Z = `normal_force` (N) cannot be set now (empty if it can): it must be finite and > 0, and
   /// the spring mattress's plate is placed once, when F_Z is first applied.
   std::string checkNormalLoad(double normal_force) const;
+  /// Replaces the scene's stop condition for the rest of the run (a controller's end of its protocol);
+  /// finished() is then that condition's. Returns the refusal reason or empty: global_events ≥ 0, time
+  /// and stage_travel > 0 (∞ allowed).
+  std::string setStopCondition(const StopSpec& stop);
 
   const Scene& scene() const { return scene_; }
   const Model& model() const { return *model_; }

@@ -402,6 +402,7 @@ void Simulation::run() {
 }
 
 void Simulation::checkStop() {
+  if (finished()) return;  // the first reason stands while a caller steps on past it
   const bool enough_events = scene_.stop.global_events > 0 && detector_.globalEventCount() >= scene_.stop.global_events;
   if (enough_events || !(time_ < scene_.stop.time) || !(stage_.travel() < scene_.stop.stage_travel)) {
     recordStopReason(enough_events);
@@ -418,6 +419,22 @@ void Simulation::checkStop() {
     reason << "reached the stage travel limit of " << scene_.stop.stage_travel << " m";
   }
   stop_reason_ = reason.str();
+}
+
+std::string Simulation::setStopCondition(const StopSpec& stop) {
+  std::ostringstream reason;
+  if (stop.global_events < 0) {
+    reason << "global_events " << stop.global_events << " is not allowed; allowed: >= 0 (0: not this condition)";
+  } else if (!(stop.time > 0.0)) {
+    reason << "time " << stop.time << " s is not allowed; allowed: > 0 s (inf: not this condition)";
+  } else if (!(stop.stage_travel > 0.0)) {
+    reason << "stage_travel " << stop.stage_travel << " m is not allowed; allowed: > 0 m (inf: not this condition)";
+  }
+  if (!reason.str().empty()) return reason.str();
+  scene_.stop = stop;
+  stop_reason_.clear();
+  checkStop();
+  return {};
 }
 
 std::string Simulation::checkNormalLoad(double normal_force) const {

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
     friction::StageController controller{ros::NodeHandle(), friction::loadProtocol(options.protocol_path),
                                          options.start_delay};
     ros::spin();
+    if (controller.failed()) return 2;
   } catch (const friction::ConfigError& error) {
     std::cerr << error.what() << std::endl;
     // A simulator started paused waits for this node's protocol: end its run rather than leave it waiting.

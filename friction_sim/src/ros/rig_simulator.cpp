@@ -102,7 +102,6 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
   scene_ = loadScene(options_.scene_path, overrides, &stability_limit_);
   for (const std::string& warning : sceneWarnings(scene_)) ROS_WARN_STREAM("scene: " << warning);
   wave_speeds_ = waveSpeeds(scene_);
-  paused_ = options_.start_paused;
   startSimulation();
   if (!options_.bag_path.empty()) {
     bag_.open(options_.bag_path, rosbag::bagmode::Write);
@@ -127,6 +126,9 @@ void RigSimulator::startSimulation() {
   pace_origin_wall_ = ros::WallTime::now();
   pace_origin_sim_ = 0.0;
   reset_requested_ = false;
+  run_end_set_ = false;
+  // A controller that started the rig paused sends its schedule again after a reset, then unpauses.
+  paused_ = options_.start_paused;
 }
 
 void RigSimulator::advertise() {
@@ -142,6 +144,7 @@ void RigSimulator::advertise() {
   pause_srv_ = nh_.advertiseService("pause", &RigSimulator::onPause, this);
   reset_srv_ = nh_.advertiseService("reset", &RigSimulator::onReset, this);
   stop_srv_ = nh_.advertiseService("stop", &RigSimulator::onStop, this);
+  run_end_srv_ = nh_.advertiseService("set_run_end", &RigSimulator::onSetRunEnd, this);
 }
 
 template <class Message>
@@ -283,6 +286,21 @@ bool RigSimulator::onStop(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
   return true;
 }
 
+bool RigSimulator::onSetRunEnd(friction_msgs::SetRunEnd::Request& request, friction_msgs::SetRunEnd::Response& response) {
+  StopSpec end;
+  end.global_events = static_cast<int>(request.global_events);
+  end.time = request.time;
+  end.stage_travel = request.stage_travel;
+  response.reason = simulation_->setStopCondition(end);
+  response.accepted = response.reason.empty();
+  if (response.accepted) {
+    run_end_set_ = true;
+  } else {
+    ROS_WARN_STREAM("run end refused: " << response.reason);
+  }
+  return true;
+}
+
 void RigSimulator::pace() {
   if (options_.real_time_factor <= 0.0) return;
   const double ahead = (simulation_->time() - pace_origin_sim_) / options_.real_time_factor -
@@ -293,6 +311,7 @@ void RigSimulator::pace() {
 void RigSimulator::run() {
   const auto start = ros::WallTime::now();
   ros::WallTime next_spin = start;
+  std::string end_reason;
   while (!stop_ && !g_stop_requested && ros::ok()) {
     const ros::WallTime now = ros::WallTime::now();
     if (now >= next_spin || paused_) {
@@ -305,6 +324,7 @@ void RigSimulator::run() {
     }
     if (paused_) {
       publishStageState(simulation_->loadCells());  // so that a controller learns the time and F_Z while the rig waits
+      publishClock(simulation_->time());  // nodes on simulated time, and `rostopic echo /clock`, see it stand still
       if (lattice_pub_.getNumSubscribers() > 0) lattice_pub_.publish(toMsg(simulation_->snapshot(), options_.frame_id));
       ros::WallDuration(0.05).sleep();
       continue;
@@ -323,14 +343,23 @@ void RigSimulator::run() {
     simulation_->advance(until);
     if (simulation_->jumps() != jumps) publishAcrossJump(cells_before, gauges_before);
     publishInstruments();
-    if (options_.stop_at_scene_end && simulation_->finished()) {
-      ROS_INFO_STREAM("scene ended: " << simulation_->stopReason());
+    if ((options_.stop_at_scene_end || run_end_set_) && simulation_->finished()) {
+      end_reason = simulation_->stopReason();
+      ROS_INFO_STREAM("run ended: " << end_reason);
       break;
     }
     pace();
   }
+  if (end_reason.empty()) {
+    std::ostringstream reason;
+    reason << (stop_ ? "stopped by the stop service" : g_stop_requested ? "interrupted by a signal" : "ROS shut down")
+           << " at t = " << simulation_->time() << " s";
+    end_reason = reason.str();
+  }
   publishStageState(simulation_->loadCells());
-  printSummary(std::cout, summarize(*simulation_, (ros::WallTime::now() - start).toSec()));
+  RunSummary summary = summarize(*simulation_, (ros::WallTime::now() - start).toSec());
+  summary.stop_reason = end_reason;
+  printSummary(std::cout, summary);
   if (bag_open_) {
     bag_.close();
     bag_open_ = false;

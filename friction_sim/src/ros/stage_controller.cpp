@@ -1,10 +1,12 @@
 #include "friction_sim/ros/stage_controller.h"
 
 #include <friction_msgs/SendStageCommand.h>
+#include <friction_msgs/SetRunEnd.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 #include "friction_sim/ros/conversions.h"
@@ -42,6 +44,7 @@ StageController::StageController(ros::NodeHandle nh, LoadingProtocol protocol, d
     : nh_(std::move(nh)), protocol_(std::move(protocol)), start_delay_(start_delay) {
   command_client_ = nh_.serviceClient<friction_msgs::SendStageCommand>("send_command");
   pause_client_ = nh_.serviceClient<std_srvs::SetBool>("pause");
+  run_end_client_ = nh_.serviceClient<friction_msgs::SetRunEnd>("set_run_end");
   state_sub_ = nh_.subscribe("stage_state", 100, &StageController::onStageState, this);
 }
 
@@ -50,14 +53,36 @@ void StageController::start(double time, double normal_force) {
   ended_ = false;
   start_time_ = time;
   command_client_.waitForExistence();
+  int refused = 0;
   for (const TimedCommand& command : scheduleProtocol(protocol_, time, normal_force)) {
     friction_msgs::SendStageCommand call;
     call.request.command = toMsg(command);
     if (!command_client_.call(call)) {
       ROS_ERROR("stage controller: send_command failed (is the simulator running?)");
+      ++refused;
     } else if (!call.response.accepted) {
       ROS_ERROR_STREAM("stage controller: command for t = " << command.time << " s refused: " << call.response.reason);
+      ++refused;
     }
+  }
+  if (refused > 0) {
+    // The run would not be the protocol's: the simulator would go on under what it had before.
+    ROS_ERROR_STREAM("stage controller: " << refused << " command(s) of the protocol refused; stopping the simulator");
+    failed_ = true;
+    stopSimulator(nh_, ros::WallDuration(5.0));
+    ros::shutdown();
+    return;
+  }
+  // The simulator ends the run itself at the protocol's end, on the step where it is reached; the
+  // watch in onStageState stays for a simulator without set_run_end.
+  friction_msgs::SetRunEnd end;
+  end.request.global_events = static_cast<std::uint32_t>(protocol_.end.global_events);
+  end.request.time = time + protocol_.end.time;
+  end.request.stage_travel = protocol_.end.stage_travel;
+  simulator_ends_run_ = run_end_client_.call(end) && end.response.accepted;
+  if (!simulator_ends_run_) {
+    ROS_WARN_STREAM("stage controller: the simulator did not take the protocol's end (" << end.response.reason
+                                                                                        << "); it will be stopped when the end is seen");
   }
   ros::WallDuration(start_delay_).sleep();
   std_srvs::SetBool run;
@@ -75,11 +100,13 @@ void StageController::onStageState(const friction_msgs::StageState::ConstPtr& ms
   }
   last_time_ = time;
   if (!started_) start(time, msg->normal_force);
+  if (failed_) return;
   if (ended_ || !protocolEnded(protocol_.end, msg->global_events, msg->travel, time - start_time_)) return;
   ended_ = true;
   ROS_INFO_STREAM("stage controller: protocol ended at t = " << time << " s after " << msg->global_events
-                                                             << " global events; stopping the simulator");
-  stopSimulator(nh_, ros::WallDuration(5.0));
+                                                             << " global events"
+                                                             << (simulator_ends_run_ ? "" : "; stopping the simulator"));
+  if (!simulator_ends_run_) stopSimulator(nh_, ros::WallDuration(5.0));
   ros::shutdown();
 }
 

@@ -19,7 +19,7 @@
 //                                   sends its schedule first, so every command is on time)
 //
 // Published topics (relative to the node's namespace; stamps are simulated time):
-//   /clock (rosgraph_msgs/Clock)                   simulated time
+//   /clock (rosgraph_msgs/Clock)                   simulated time; at 20 Hz of wall time while paused
 //   load_cells (geometry_msgs/WrenchStamped)       F_X in force.x, F_Z in force.z
 //   strain_gauges (friction_msgs/StrainGaugeProfile)
 //   interface (friction_msgs/InterfaceState)       also at every step where a node unsticks or an event ends
@@ -30,13 +30,20 @@
 //   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time)
 // Services:
 //   send_command (friction_msgs/SendStageCommand)  the same, with the verdict in the reply
+//   set_run_end (friction_msgs/SetRunEnd)         ends the run at the first step where a count of global
+//                                                  events, a simulated time or a stage travel is reached,
+//                                                  in place of the scene's stop condition and of
+//                                                  ~stop_at_scene_end (a controller's end of its protocol,
+//                                                  so that a run ends where it should however fast it runs)
 //   pause (std_srvs/SetBool), reset (std_srvs/Trigger), stop (std_srvs/Trigger)
+//   A reset restarts the scene from t = 0 with the scene's stop condition, paused if ~start_paused.
 //
 // Commands with NaN/inf, a normal load <= 0, a speed beyond the scene's stage.max_speed or an unknown
 // mode are refused with a logged reason; the simulation keeps running.
 #pragma once
 
 #include <friction_msgs/SendStageCommand.h>
+#include <friction_msgs/SetRunEnd.h>
 #include <friction_msgs/StageCommand.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
@@ -111,6 +118,7 @@ class RigSimulator {
   bool onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   bool onReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onStop(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  bool onSetRunEnd(friction_msgs::SetRunEnd::Request& request, friction_msgs::SetRunEnd::Response& response);
   void pace();
   template <class Message>
   void emit(ros::Publisher& publisher, const std::string& topic, const Message& msg);
@@ -128,6 +136,7 @@ class RigSimulator {
   bool paused_ = false;
   bool stop_ = false;
   bool reset_requested_ = false;
+  bool run_end_set_ = false;  ///< set_run_end was called: the run ends when the simulation finishes
   std::uint32_t frame_index_ = 0;
   double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0,
          next_lattice_ = 0;
@@ -135,7 +144,7 @@ class RigSimulator {
   double pace_origin_sim_ = 0.0;
   ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_;
   ros::Subscriber command_sub_;
-  ros::ServiceServer command_srv_, pause_srv_, reset_srv_, stop_srv_;
+  ros::ServiceServer command_srv_, pause_srv_, reset_srv_, stop_srv_, run_end_srv_;
 };
 
 }  // namespace friction

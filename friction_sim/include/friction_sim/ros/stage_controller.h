@@ -8,12 +8,17 @@
 // Subscribed topics (relative to the node's namespace):
 //   stage_state (friction_msgs/StageState)  simulated time, F_Z, stage travel, global event count
 // Services called:
-//   send_command (friction_msgs/SendStageCommand)  every scheduled command, stamped with its time
+//   send_command (friction_msgs/SendStageCommand)  every scheduled command, stamped with its time; if the
+//                                                   simulator refuses one, the controller stops it and
+//                                                   exits with status 2 (the run would not be the protocol's)
+//   set_run_end (friction_msgs/SetRunEnd)           the protocol's end, so that the simulator ends the run
+//                                                   on the step where it is reached
 //   pause (std_srvs/SetBool)                        called with false once the schedule is sent, so
 //                                                   that a simulator started paused runs every command on time
-//   stop (std_srvs/Trigger)                        once an end condition of the protocol holds, or when
-//                                                   the protocol or a parameter is refused (the node then
-//                                                   exits with status 2, the problems listed on stderr)
+//   stop (std_srvs/Trigger)                        once an end condition of the protocol holds, if the
+//                                                   simulator did not take it through set_run_end; or when
+//                                                   the protocol, a parameter or a command is refused (the
+//                                                   node then exits with status 2, the problems listed)
 //
 // Uses ROS time only (the stage state's stamps, i.e. simulated time). If time jumps backwards (a reset
 // or looped playback), it starts the protocol again from the new time.
@@ -48,6 +53,9 @@ bool stopSimulator(ros::NodeHandle& nh, ros::WallDuration wait);
 class StageController {
  public:
   StageController(ros::NodeHandle nh, LoadingProtocol protocol, double start_delay);
+  /// The simulator refused a command of the protocol (or could not be reached): the node has stopped it
+  /// and shut down.
+  bool failed() const { return failed_; }
 
  private:
   void onStageState(const friction_msgs::StageState::ConstPtr& msg);
@@ -57,7 +65,9 @@ class StageController {
   LoadingProtocol protocol_;
   double start_delay_;
   ros::Subscriber state_sub_;
-  ros::ServiceClient command_client_, pause_client_;
+  ros::ServiceClient command_client_, pause_client_, run_end_client_;
+  bool failed_ = false;
+  bool simulator_ends_run_ = false;  ///< the simulator took the protocol's end (set_run_end)
   bool started_ = false;
   bool ended_ = false;
   double start_time_ = 0.0;
