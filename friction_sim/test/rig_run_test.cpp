@@ -10,6 +10,7 @@
 #include <friction_msgs/LatticeSnapshot.h>
 #include <friction_msgs/PrecursorPoint.h>
 #include <friction_msgs/SendStageCommand.h>
+#include <friction_msgs/SetRunEnd.h>
 #include <friction_msgs/SlipEvent.h>
 #include <friction_msgs/StageState.h>
 #include <friction_msgs/StrainGaugeProfile.h>
@@ -55,6 +56,7 @@ struct Observed {
   int stops_after_bad_protocol = 0;
   std::string refused_command_output;
   int refused_command_status = 0, stops_after_refused_command = 0, unpauses_after_refused_command = 0;
+  int reset_controller_status = -1, commands_around_reset = 0, run_ends_around_reset = 0, unpauses_around_reset = 0;
 };
 Observed g_seen;
 std::string g_bag;
@@ -146,6 +148,56 @@ void runProtocolAgainstARefusingSimulator(const std::string& protocol) {
       "rosrun friction_sim stage_controller __name:=controller __ns:=/refused_command _start_delay:=0 _protocol:=" +
           protocol,
       g_seen.refused_command_output);
+  spinner.stop();
+}
+
+/// A controller whose simulator is reset while it waits to start: a stand-in that announces t = 0,
+/// takes every command and run end, and when first unpaused announces a reset with the time still 0
+/// (the count of resets alone shows it), then, unpaused again, the protocol's end (two global events).
+void runControllerThroughAResetAtTheStart(const std::string& protocol) {
+  ros::CallbackQueue queue;
+  ros::NodeHandle nh("/reset_at_start");
+  nh.setCallbackQueue(&queue);
+  ros::Publisher state = nh.advertise<friction_msgs::StageState>("stage_state", 1, true);
+  auto announce = [&state](std::uint32_t resets, double time, std::uint32_t global_events, bool paused) {
+    friction_msgs::StageState msg;
+    msg.header.stamp = ros::Time(time);
+    msg.normal_force = 1920.0;
+    msg.resets = resets;
+    msg.global_events = global_events;
+    msg.paused = paused;
+    state.publish(msg);
+  };
+  const boost::function<bool(friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response&)>
+      take = [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
+        ++g_seen.commands_around_reset;
+        response.accepted = true;
+        return true;
+      };
+  const boost::function<bool(friction_msgs::SetRunEnd::Request&, friction_msgs::SetRunEnd::Response&)> take_end =
+      [](friction_msgs::SetRunEnd::Request&, friction_msgs::SetRunEnd::Response& response) {
+        ++g_seen.run_ends_around_reset;
+        response.accepted = true;
+        return true;
+      };
+  const boost::function<bool(std_srvs::SetBool::Request&, std_srvs::SetBool::Response&)> unpause =
+      [&announce](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
+        if (!request.data && ++g_seen.unpauses_around_reset == 1) announce(1, 0.0, 0, true);
+        if (!request.data && g_seen.unpauses_around_reset == 2) announce(1, 0.1, 2, false);
+        response.success = true;
+        return true;
+      };
+  ros::ServiceServer commands = nh.advertiseService("send_command", take);
+  ros::ServiceServer run_end = nh.advertiseService("set_run_end", take_end);
+  ros::ServiceServer pause = nh.advertiseService("pause", unpause);
+  announce(0, 0.0, 0, true);
+  ros::AsyncSpinner spinner(1, &queue);
+  spinner.start();
+  std::string output;
+  g_seen.reset_controller_status = runCommand(
+      "rosrun friction_sim stage_controller __name:=controller __ns:=/reset_at_start _start_delay:=0 _protocol:=" +
+          protocol,
+      output);
   spinner.stop();
 }
 
@@ -280,6 +332,19 @@ TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
   EXPECT_EQ(g_seen.unpauses_after_refused_command, 0);
 }
 
+TEST(FullRun, ControllerStartsOverAfterAResetThatCameBeforeTimeMovedOn) {
+  // The schedule and the run end are sent again after the reset; the simulator ends the run at the
+  // protocol's end, and the controller exits cleanly.
+  ros::NodeHandle pnh("~");
+  std::string protocol;
+  pnh.getParam("protocol", protocol);
+  const std::size_t schedule = scheduleProtocol(loadProtocol(protocol), 0.0, 1920.0).size();
+  EXPECT_EQ(g_seen.reset_controller_status, 0);
+  EXPECT_EQ(g_seen.commands_around_reset, static_cast<int>(2 * schedule));
+  EXPECT_EQ(g_seen.run_ends_around_reset, 2);
+  EXPECT_EQ(g_seen.unpauses_around_reset, 2);
+}
+
 TEST(FullRun, BagHoldsEverySlipEventAndEveryInterfaceFrame) {
   ASSERT_GE(g_seen.events.size(), 2u);
   checkBagHasEveryEventAndNoFrameGap(g_seen.events);
@@ -405,6 +470,7 @@ void watchFullRun(ros::NodeHandle& nh) {
     std::string protocol;
     pnh.getParam("protocol", protocol);
     runProtocolAgainstARefusingSimulator(protocol);
+    runControllerThroughAResetAtTheStart(protocol);
   }
   // The controller ends the run after two global events; the simulator then closes its bag.
   waitFor([] { return bagReadable(g_bag); }, 240.0);

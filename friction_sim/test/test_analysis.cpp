@@ -126,6 +126,28 @@ TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
   EXPECT_EQ(staggered_front.left_out, 4);
   EXPECT_NEAR(staggered_front.median, speed, 1e-6);
 
+  // Two spots that unstick at once are two patches, not one spanning the front between them: here node
+  // 11 unsticks with node 0 while a front runs from node 0 through node 10.
+  std::vector<double> two_spots(12);
+  for (int node = 0; node < 12; ++node) two_spots[node] = node * spacing / speed;
+  two_spots[11] = 0.0;
+  const std::vector<double> two_spots_v_c = frontSpeeds(positions, two_spots, 5);
+  const FrontSpeedSummary two_spots_front = summarizeFrontSpeeds(two_spots_v_c, two_spots, 5, c.longitudinal);
+  EXPECT_EQ(two_spots_front.left_out, 6);  // nodes 0–2 and 9–11, whose windows hold node 0 or node 11
+  EXPECT_NEAR(two_spots_front.median, speed, 1e-9);
+
+  // A patch in the middle (nodes 5–7) with fronts running out both ways, and an even window (4 nodes:
+  // 2 behind, 1 ahead): left out are the nodes whose window [node − 2, node + 1] holds a patch node, 4–9.
+  std::vector<double> middle_positions, middle(13);
+  for (int node = 0; node < 13; ++node) {
+    middle_positions.push_back(node * spacing);
+    middle[node] = (node < 5 ? 5 - node : node > 7 ? node - 7 : 0) * spacing / speed;
+  }
+  const std::vector<double> middle_v_c = frontSpeeds(middle_positions, middle, 4);
+  const FrontSpeedSummary middle_front = summarizeFrontSpeeds(middle_v_c, middle, 4, c.longitudinal);
+  EXPECT_EQ(middle_front.left_out, 6);
+  EXPECT_NEAR(middle_front.median, speed, 1e-9);
+
   // Away from the patch only fits above c_L are left out (with c_L unknown, infinite ones); an even
   // count takes the mean of the middle two.
   const double infinity = std::numeric_limits<double>::infinity();

@@ -194,35 +194,43 @@ TEST(DetectorOptions, EveryBadParameterIsNamedWithValueAndRange) {
   options.overrides = "material.density=1200 broken";
   const auto problems = validateDetectorOptions(options);
   ASSERT_EQ(problems.size(), 3u);
-  EXPECT_NE(problems[0].find("~front_fit_nodes: value 1 is not allowed; allowed: >= 2"), std::string::npos);
+  EXPECT_NE(problems[0].find("~front_fit_nodes: value 1 is not allowed; allowed: >= 2, or 0 for the scene's"),
+            std::string::npos);
   EXPECT_NE(problems[1].find("~overrides: 'material.density=1200 broken' given without ~scene"), std::string::npos);
   EXPECT_NE(problems[2].find("~overrides: item 'broken'"), std::string::npos);
 }
 
-TEST(DetectorOptions, TheRunsSceneGivesTheModelsWaveSpeeds) {
+TEST(DetectorOptions, TheRunsSceneGivesTheModelsWaveSpeedsAndFitWindow) {
   DetectorOptions options;
-  const WaveSpeeds unknown = detectorWaveSpeeds(options);
+  const DetectorSettings without_scene = resolveDetectorSettings(options);
+  const WaveSpeeds unknown = without_scene.wave_speeds;
   EXPECT_EQ(unknown.longitudinal, 0.0);
   EXPECT_EQ(unknown.shear, 0.0);
   EXPECT_EQ(unknown.rayleigh, 0.0);
+  EXPECT_EQ(without_scene.front_fit_nodes, 5);
   // MODEL.md §2 with the default numbers: c_S = √(3E/(8ρ)) ≈ 968 m/s, c_L ≈ 1677 m/s, c_R ≈ 0.919·c_S.
   options.scene_path = SCENE_DIR "/pmma_2d.yaml";
-  const WaveSpeeds lattice = detectorWaveSpeeds(options);
+  const WaveSpeeds lattice = resolveDetectorSettings(options).wave_speeds;
   EXPECT_NEAR(lattice.shear, 968.2, 0.1);
   EXPECT_NEAR(lattice.longitudinal, 1677.05, 0.01);
   EXPECT_NEAR(lattice.rayleigh, 0.919 * lattice.shear, 1e-9);
   // The run's overrides apply: a quarter of the density doubles every speed.
-  options.overrides = "material.density=300";
-  EXPECT_NEAR(detectorWaveSpeeds(options).shear, 2 * lattice.shear, 1e-9);
+  options.overrides = "material.density=300 instruments.front_fit_nodes=7";
+  const DetectorSettings overridden = resolveDetectorSettings(options);
+  EXPECT_NEAR(overridden.wave_speeds.shear, 2 * lattice.shear, 1e-9);
+  EXPECT_EQ(overridden.front_fit_nodes, 7);  // fitted as the simulator fits that run
+  options.front_fit_nodes = 3;
+  EXPECT_EQ(resolveDetectorSettings(options).front_fit_nodes, 3);
+  options.front_fit_nodes = 0;
   // The chain has the bar speed √(E/ρ) and no surface wave.
   options.scene_path = SCENE_DIR "/pmma_1d_side.yaml";
   options.overrides.clear();
-  const WaveSpeeds chain = detectorWaveSpeeds(options);
+  const WaveSpeeds chain = resolveDetectorSettings(options).wave_speeds;
   EXPECT_NEAR(chain.shear, std::sqrt(3.0e9 / 1200.0), 1e-9);
   EXPECT_EQ(chain.rayleigh, 0.0);
   // A scene the simulator would refuse is refused here too.
   options.overrides = "material.density=-1";
-  EXPECT_THROW(detectorWaveSpeeds(options), ConfigError);
+  EXPECT_THROW(resolveDetectorSettings(options), ConfigError);
 }
 
 }  // namespace

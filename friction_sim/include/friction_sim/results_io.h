@@ -36,8 +36,8 @@ struct RunSummary {
 RunSummary summarize(const Simulation& simulation, double wall_time);
 void printSummary(std::ostream& out, const RunSummary& summary);
 
-/// One row per event. Its front speed is the median v_c of the nodes a front ran across (at most c_L),
-/// also as v_c/c_S and v_c/c_R (MODEL.md §6), with the count of nodes whose fit was faster than c_L.
+/// One row per event. Its front speed is the running front's median v_c (summarizeFrontSpeeds), also as
+/// v_c/c_S and v_c/c_R (MODEL.md §6), with the count of fits left out of it.
 void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, const Scene& scene);
 /// One row per (event, interface node): slip, first-unstick time and front speed.
 void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,

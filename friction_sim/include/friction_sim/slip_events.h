@@ -2,6 +2,7 @@
 // and ends when all are stuck again. Detected from the contact interface after every step.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include "friction_sim/contact_interface.h"
@@ -25,7 +26,7 @@ struct SlipEvent {
   std::vector<double> node_slip;    ///< m, per interface node, displacement during the event
   std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
   std::vector<double> front_speed;  ///< m/s, v_c per node from the first-unstick times; NaN where undefined
-  double median_front_speed = 0.0;  ///< m/s, the event's front speed in one number (summarizeFrontSpeeds)
+  double median_front_speed = std::numeric_limits<double>::quiet_NaN();  ///< m/s, summarizeFrontSpeeds; NaN: none
   int front_fits_left_out = 0;      ///< fits left out of that median (summarizeFrontSpeeds)
 };
 
@@ -106,5 +107,9 @@ struct FrontSpeedSummary {
 FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
                                        const std::vector<double>& first_unstick_time, int fit_nodes,
                                        double longitudinal_speed);
+
+/// Sets an ended event's front_speed (frontSpeeds, from its first_unstick_time at the nodes' `positions`,
+/// m), median_front_speed and front_fits_left_out (summarizeFrontSpeeds).
+void measureFronts(SlipEvent& event, const std::vector<double>& positions, int fit_nodes, double longitudinal_speed);
 
 }  // namespace friction

@@ -107,11 +107,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   event.slip_max_x = x_max;
   event.rupture_length = slipped ? x_max - x_min : 0.0;
   event.global = slipped == n;
-  event.front_speed = frontSpeeds(frame.position, event.first_unstick_time, front_fit_nodes_);
-  const FrontSpeedSummary front =
-      summarizeFrontSpeeds(event.front_speed, event.first_unstick_time, front_fit_nodes_, longitudinal_speed_);
-  event.median_front_speed = front.median;
-  event.front_fits_left_out = front.left_out;
+  measureFronts(event, frame.position, front_fit_nodes_, longitudinal_speed_);
   last_stuck_frame_ = frame;
   ended_.push_back(std::move(event));
 }

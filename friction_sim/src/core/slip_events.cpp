@@ -75,11 +75,7 @@ void SlipEventDetector::finish(double end_time, const Vector& u, double end_shea
   event.slip_max_x = x_max;
   event.rupture_length = x_max - x_min;
   event.global = slipped == n;
-  event.front_speed = frontSpeeds(positions_, event.first_unstick_time, fit_nodes_);
-  const FrontSpeedSummary front = summarizeFrontSpeeds(event.front_speed, event.first_unstick_time, fit_nodes_,
-                                                       longitudinal_speed_);
-  event.median_front_speed = front.median;
-  event.front_fits_left_out = front.left_out;
+  measureFronts(event, positions_, fit_nodes_, longitudinal_speed_);
   if (event.global) ++global_count_;
   events_.push_back(std::move(event));
 }
@@ -143,22 +139,25 @@ FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
     const double speed = front_speed[node];
     return !std::isnan(speed) && (!std::isfinite(speed) || (limit_known && speed > longitudinal_speed));
   };
-  // The patch: the node(s) that unstuck first, grown through neighbours whose fits are too fast.
+  // The patches: each run of adjacent nodes that unstuck first (two spots may nucleate at once), grown
+  // through neighbours whose fits are too fast, for those unstuck too nearly together to have a front.
   double first_time = std::numeric_limits<double>::infinity();
   for (double time : first_unstick_time) {
     if (!std::isnan(time)) first_time = std::min(first_time, time);
   }
-  int patch_low = n, patch_high = -1;
-  for (int node = 0; node < n; ++node) {
-    if (first_unstick_time[node] != first_time) continue;
-    patch_low = std::min(patch_low, node);
-    patch_high = node;
-  }
-  while (patch_low > 0 && patch_low <= patch_high && too_fast(patch_low - 1)) --patch_low;
-  while (patch_high >= 0 && patch_high + 1 < n && too_fast(patch_high + 1)) ++patch_high;
-  // A node's window [node − behind, node + ahead] reaches into [patch_low, patch_high].
+  std::vector<char> in_patch(n, 0);
+  for (int node = 0; node < n; ++node) in_patch[node] = first_unstick_time[node] == first_time;
+  for (int node = 1; node < n; ++node) in_patch[node] |= in_patch[node - 1] && too_fast(node);
+  for (int node = n - 2; node >= 0; --node) in_patch[node] |= in_patch[node + 1] && too_fast(node);
+  // patches_before[i]: patch nodes among nodes [0, i). A fit's window [node − behind, node + ahead]
+  // (frontFitWindow) mixes a patch's times into its slope when it holds a patch node.
+  std::vector<int> patches_before(n + 1, 0);
+  for (int node = 0; node < n; ++node) patches_before[node + 1] = patches_before[node] + in_patch[node];
   const FitWindow window = frontFitWindow(fit_nodes);
-  auto near_patch = [&](int node) { return node >= patch_low - window.ahead && node <= patch_high + window.behind; };
+  auto near_patch = [&](int node) {
+    const int low = std::max(node - window.behind, 0), high = std::min(node + window.ahead, n - 1);
+    return patches_before[high + 1] > patches_before[low];
+  };
   std::vector<double> running;
   for (int node = 0; node < n; ++node) {
     if (std::isnan(front_speed[node])) continue;
@@ -176,6 +175,14 @@ FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
   const std::size_t middle = running.size() / 2;
   summary.median = running.size() % 2 ? running[middle] : 0.5 * (running[middle - 1] + running[middle]);
   return summary;
+}
+
+void measureFronts(SlipEvent& event, const std::vector<double>& positions, int fit_nodes, double longitudinal_speed) {
+  event.front_speed = frontSpeeds(positions, event.first_unstick_time, fit_nodes);
+  const FrontSpeedSummary front =
+      summarizeFrontSpeeds(event.front_speed, event.first_unstick_time, fit_nodes, longitudinal_speed);
+  event.median_front_speed = front.median;
+  event.front_fits_left_out = front.left_out;
 }
 
 }  // namespace friction

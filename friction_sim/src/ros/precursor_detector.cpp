@@ -8,9 +8,9 @@ namespace friction {
 
 std::vector<std::string> validateDetectorOptions(const DetectorOptions& options) {
   std::vector<std::string> problems;
-  if (options.front_fit_nodes < 2) {
+  if (options.front_fit_nodes < 2 && options.front_fit_nodes != 0) {
     problems.push_back("~front_fit_nodes: value " + std::to_string(options.front_fit_nodes) +
-                       " is not allowed; allowed: >= 2");
+                       " is not allowed; allowed: >= 2, or 0 for the scene's");
   }
   if (options.scene_path.empty() && !options.overrides.empty()) {
     problems.push_back("~overrides: '" + options.overrides + "' given without ~scene; allowed: overrides of a scene");
@@ -29,15 +29,23 @@ DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh) {
   return options;
 }
 
-WaveSpeeds detectorWaveSpeeds(const DetectorOptions& options) {
-  if (options.scene_path.empty()) return {};
-  std::vector<std::string> ignored;  // validateDetectorOptions has refused malformed overrides
-  return waveSpeeds(loadScene(options.scene_path, parseOverrides(options.overrides, ignored)));
+DetectorSettings resolveDetectorSettings(const DetectorOptions& options) {
+  DetectorSettings settings;
+  if (!options.scene_path.empty()) {
+    std::vector<std::string> ignored;  // validateDetectorOptions has refused malformed overrides
+    const Scene scene = loadScene(options.scene_path, parseOverrides(options.overrides, ignored));
+    settings.wave_speeds = waveSpeeds(scene);
+    settings.front_fit_nodes = scene.instruments.front_fit_nodes;
+  }
+  if (options.front_fit_nodes != 0) settings.front_fit_nodes = options.front_fit_nodes;
+  return settings;
 }
 
 PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private_nh, const DetectorOptions& options)
-    : nh_(std::move(nh)), private_nh_(std::move(private_nh)), wave_speeds_(detectorWaveSpeeds(options)) {
-  detector_ = std::make_unique<FrameEventDetector>(options.front_fit_nodes, wave_speeds_.longitudinal);
+    : nh_(std::move(nh)), private_nh_(std::move(private_nh)) {
+  const DetectorSettings settings = resolveDetectorSettings(options);
+  wave_speeds_ = settings.wave_speeds;
+  detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, wave_speeds_.longitudinal);
   events_pub_ = private_nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   points_pub_ = private_nh_.advertise<friction_msgs::PrecursorPoint>("precursor_points", 1000, true);
   // Deep queues: a bag played fast must not drop frames, or events would be merged.

@@ -2,8 +2,10 @@
 
 #include <rosgraph_msgs/Clock.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "friction_sim/results_io.h"
@@ -175,6 +177,7 @@ void RigSimulator::publishStageState(const LoadCellReading& cells) {
   msg.normal_force = cells.normal_force;
   msg.global_events = simulation_->globalEventCount();
   msg.paused = paused_;
+  msg.resets = resets_;
   emit(stage_pub_, "stage_state", msg);
 }
 
@@ -288,7 +291,8 @@ bool RigSimulator::onStop(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
 
 bool RigSimulator::onSetRunEnd(friction_msgs::SetRunEnd::Request& request, friction_msgs::SetRunEnd::Response& response) {
   StopSpec end;
-  end.global_events = static_cast<int>(request.global_events);
+  // Beyond int's range a count is never reached anyway.
+  end.global_events = static_cast<int>(std::min<std::uint32_t>(request.global_events, std::numeric_limits<int>::max()));
   end.time = request.time;
   end.stage_travel = request.stage_travel;
   response.reason = simulation_->setStopCondition(end);
@@ -319,6 +323,7 @@ void RigSimulator::run() {
       next_spin = now + ros::WallDuration(0.002);
     }
     if (reset_requested_) {
+      ++resets_;
       startSimulation();
       continue;
     }

@@ -81,8 +81,9 @@ void StageController::start(double time, double normal_force) {
   end.request.stage_travel = protocol_.end.stage_travel;
   simulator_ends_run_ = run_end_client_.call(end) && end.response.accepted;
   if (!simulator_ends_run_) {
-    ROS_WARN_STREAM("stage controller: the simulator did not take the protocol's end (" << end.response.reason
-                                                                                        << "); it will be stopped when the end is seen");
+    ROS_WARN_STREAM("stage controller: the simulator did not take the protocol's end ("
+                    << (end.response.reason.empty() ? "no set_run_end service" : end.response.reason)
+                    << "); it will be stopped when the end is seen");
   }
   ros::WallDuration(start_delay_).sleep();
   std_srvs::SetBool run;
@@ -93,12 +94,15 @@ void StageController::start(double time, double normal_force) {
 
 void StageController::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
   const double time = msg->header.stamp.toSec();
-  if (started_ && time < last_time_) {
-    ROS_WARN_STREAM("stage controller: time jumped back from " << last_time_ << " s to " << time
-                                                              << " s; restarting the protocol");
+  // A reset shows as a new count, also when it comes before time has moved on (while the controller
+  // waits to unpause), where the time alone would not show it.
+  if (started_ && (time < last_time_ || msg->resets != resets_seen_)) {
+    ROS_WARN_STREAM("stage controller: the simulation restarted (t = " << time << " s, " << msg->resets
+                                                                       << " resets); restarting the protocol");
     started_ = false;
   }
   last_time_ = time;
+  resets_seen_ = msg->resets;
   if (!started_) start(time, msg->normal_force);
   if (failed_) return;
   if (ended_ || !protocolEnded(protocol_.end, msg->global_events, msg->travel, time - start_time_)) return;

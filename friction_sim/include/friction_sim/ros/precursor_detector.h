@@ -4,10 +4,12 @@
 // analysis itself in a ROS-free class (here FrameEventDetector) that you can unit-test.
 //
 // Parameters (private, ~):
-//   front_fit_nodes (int, 5)   nodes in the sliding fit of the front speed, >= 2
+//   front_fit_nodes (int, 0)   nodes in the sliding fit of the front speed, >= 2; 0 = the scene's
+//                              instruments.front_fit_nodes (as the simulator fits), 5 without a scene
 //   scene (string, "")         the run's scene YAML: its model's wave speeds go into the events, so that
 //                              v_c/c_R and v_c/c_S can be read off them (the instruments do not tell
-//                              them, as a lab takes c_R of its PMMA from the literature); "" = unknown (0)
+//                              them, as a lab takes c_R of its PMMA from the literature); "" = unknown (0).
+//                              Validated as the simulator does (a 10^6-node lattice's takes ~15 s)
 //   overrides (string, "")     the run's scene overrides, "key=value key=value", as the simulator's
 // Subscribed topics (relative to the node's namespace):
 //   load_cells (geometry_msgs/WrenchStamped), interface (friction_msgs/InterfaceState)
@@ -33,7 +35,8 @@
 namespace friction {
 
 struct DetectorOptions {
-  int front_fit_nodes = 5;  ///< nodes in the sliding linear fit of the front speed v_c(x)
+  /// nodes in the sliding linear fit of the front speed v_c(x); 0 = the scene's, 5 without one
+  int front_fit_nodes = 0;
   std::string scene_path;   ///< the run's scene YAML, for the model's wave speeds; "" = unknown
   std::string overrides;    ///< "key=value ..." scene fields the run replaced
 };
@@ -42,8 +45,13 @@ struct DetectorOptions {
 std::vector<std::string> validateDetectorOptions(const DetectorOptions& options);
 /// Reads the options from the private parameters; throws ConfigError listing every problem.
 DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh);
-/// m/s, the wave speeds of the options' scene (all 0 without one); throws ConfigError if it is refused.
-WaveSpeeds detectorWaveSpeeds(const DetectorOptions& options);
+/// What the detector takes from the run's scene.
+struct DetectorSettings {
+  WaveSpeeds wave_speeds;    ///< m/s, the model's (all 0, unknown, without a scene)
+  int front_fit_nodes = 5;  ///< the options' or the scene's
+};
+/// Loads the options' scene, if any; throws ConfigError if it is refused.
+DetectorSettings resolveDetectorSettings(const DetectorOptions& options);
 
 class PrecursorDetector {
  public:

@@ -51,6 +51,7 @@
 #include <std_srvs/Trigger.h>
 
 #include <atomic>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -137,6 +138,7 @@ class RigSimulator {
   bool stop_ = false;
   bool reset_requested_ = false;
   bool run_end_set_ = false;  ///< set_run_end was called: the run ends when the simulation finishes
+  std::uint32_t resets_ = 0;  ///< resets so far, in stage_state: a controller cannot always tell one by the time
   std::uint32_t frame_index_ = 0;
   double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0,
          next_lattice_ = 0;

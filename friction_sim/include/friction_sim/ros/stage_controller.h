@@ -20,12 +20,14 @@
 //                                                   the protocol, a parameter or a command is refused (the
 //                                                   node then exits with status 2, the problems listed)
 //
-// Uses ROS time only (the stage state's stamps, i.e. simulated time). If time jumps backwards (a reset
-// or looped playback), it starts the protocol again from the new time.
+// Uses ROS time only (the stage state's stamps, i.e. simulated time). If time jumps backwards or the
+// stage state's reset count changes (a reset), it starts the protocol again from the new time.
 #pragma once
 
 #include <friction_msgs/StageState.h>
 #include <ros/ros.h>
+
+#include <cstdint>
 
 #include <string>
 #include <vector>
@@ -68,6 +70,7 @@ class StageController {
   ros::ServiceClient command_client_, pause_client_, run_end_client_;
   bool failed_ = false;
   bool simulator_ends_run_ = false;  ///< the simulator took the protocol's end (set_run_end)
+  std::uint32_t resets_seen_ = 0;    ///< the simulator's reset count in the last stage_state
   bool started_ = false;
   bool ended_ = false;
   double start_time_ = 0.0;
