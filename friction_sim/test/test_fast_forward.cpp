@@ -27,6 +27,22 @@ TEST(FastForward, StaticJumpAgreesWithALongDampedDynamicRelaxation) {
               1e-6 * dynamic.loadCells().shear_force);
 }
 
+TEST(FastForward, AStageTravelLimitEndsTheRunWithinAStepOfIt) {
+  // 20 µm of travel comes long before the first precursor (about 55 µm): a jump toward that threshold
+  // would pass the limit by micrometres if it were cut only at the time limit.
+  Scene scene = testing::coarseSliderScene(true);
+  scene.stop.global_events = 0;
+  scene.stop.stage_travel = 20e-6;
+  Simulation simulation(scene);
+  simulation.run();
+  EXPECT_GT(simulation.jumps(), 0);
+  EXPECT_TRUE(simulation.events().empty());
+  EXPECT_GE(simulation.stage().travel(), 20e-6);
+  const double one_step = std::abs(simulation.stage().velocity()) * simulation.timeStep();
+  EXPECT_LE(simulation.stage().travel(), 20e-6 + 1.001 * one_step);
+  EXPECT_NE(simulation.stopReason().find("stage travel limit"), std::string::npos) << simulation.stopReason();
+}
+
 TEST(FastForward, AgreesWithFullDynamicsOnPrecursorsAndFirstGlobalEvent) {
   Simulation full(testing::coarseSliderScene(false)), fast(testing::coarseSliderScene(true));
   full.run();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -125,8 +126,12 @@ bool Simulation::fastForward(double until) {
 
 bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   const double horizon = std::min({until, scene_.stop.time}) - time_;
-  const double span = std::min(horizon, stage_.timeToNextChange());
   const double speed = stage_.velocity();
+  // The stage's speed holds until its next change, so a travel limit falls at a known time: the jump
+  // stops there, as full dynamics stops on the step that reaches it.
+  const double to_travel_limit =
+      speed != 0.0 ? (scene_.stop.stage_travel - stage_.travel()) / std::abs(speed) : std::numeric_limits<double>::infinity();
+  const double span = std::min({horizon, stage_.timeToNextChange(), to_travel_limit});
   toward_threshold = false;
   StaticSolver* solver = pinnedSolver();
   if (!(span > dt_) || !solver) return false;
