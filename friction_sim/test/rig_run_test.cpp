@@ -51,8 +51,8 @@ struct Observed {
   std::map<std::string, std::string> topic_types;
   std::vector<friction_msgs::SendStageCommand::Response> bad_command_replies;
   double time_after_bad_commands = 0.0;
-  std::string bad_scene_output, bad_parameter_output, bad_protocol_output;
-  int bad_scene_status = 0, bad_parameter_status = 0, bad_protocol_status = 0;
+  std::string bad_scene_output, bad_parameter_output, bad_protocol_output, bad_detector_output;
+  int bad_scene_status = 0, bad_parameter_status = 0, bad_protocol_status = 0, bad_detector_status = 0;
   int stops_after_bad_protocol = 0;
   std::string refused_command_output;
   int refused_command_status = 0, stops_after_refused_command = 0, unpauses_after_refused_command = 0;
@@ -314,6 +314,12 @@ TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
   EXPECT_NE(g_seen.bad_scene_output.find("scene refused"), std::string::npos) << g_seen.bad_scene_output;
   EXPECT_NE(g_seen.bad_scene_output.find("friction.kinetic_coefficient: value 0.9"), std::string::npos);
   EXPECT_NE(g_seen.bad_scene_output.find("pusher.height: value 1"), std::string::npos);
+  // The precursor detector refuses its parameters at start, every problem named.
+  EXPECT_EQ(g_seen.bad_detector_status, 2);
+  EXPECT_NE(g_seen.bad_detector_output.find("~front_fit_nodes: value 1 is not allowed"), std::string::npos)
+      << g_seen.bad_detector_output;
+  EXPECT_NE(g_seen.bad_detector_output.find("~overrides: 'broken' given without ~scene"), std::string::npos)
+      << g_seen.bad_detector_output;
   EXPECT_EQ(g_seen.bad_parameter_status, 2);
   EXPECT_NE(g_seen.bad_parameter_output.find("~load_cell_rate: value -1"), std::string::npos)
       << g_seen.bad_parameter_output;
@@ -465,6 +471,9 @@ void watchFullRun(ros::NodeHandle& nh) {
   g_seen.bad_parameter_status = runCommand(
       "rosrun friction_sim rig_simulator __name:=bad_parameter _load_cell_rate:=-1.0 _scene:=" + scene,
       g_seen.bad_parameter_output);
+  g_seen.bad_detector_status = runCommand(
+      "rosrun friction_sim precursor_detector __name:=bad_detector _front_fit_nodes:=1 _overrides:=broken",
+      g_seen.bad_detector_output);
   runRefusedProtocol();
   {
     std::string protocol;
@@ -475,9 +484,10 @@ void watchFullRun(ros::NodeHandle& nh) {
   // The controller ends the run after two global events; the simulator then closes its bag.
   waitFor([] { return bagReadable(g_bag); }, 240.0);
   waitFor([] { return g_seen.live_points.size() >= g_seen.events.size(); }, 10.0);
-  // Replay the bag into the second detector, under its own names.
+  // Replay the bag into the second detector, under its own names, once it listens: on a loaded machine
+  // a fixed delay let the first frames go by before it had connected, and with them an event.
   std::string output;
-  runCommand("rosbag play --quiet -d 2 -r 10 --queue 1000000 " + g_bag +
+  runCommand("rosbag play --quiet --wait-for-subscribers -r 10 --queue 1000000 " + g_bag +
                  " --topics /rig/load_cells /rig/interface /rig/load_cells:=/replay/load_cells /rig/interface:=/replay/interface",
              output);
   waitFor([] { return g_seen.replay_points.size() >= g_seen.events.size(); }, 30.0);

@@ -370,6 +370,9 @@ void RigSimulator::run() {
     bag_open_ = false;
     std::cout << "  bag written to " << options_.bag_path << std::endl;
   }
+  // roscpp sends from its own thread: a node that exits at once can drop what it published last (the
+  // last slip event, now that a run ends on the step of its last event).
+  if (ros::ok()) ros::WallDuration(0.5).sleep();
 }
 
 }  // namespace friction
