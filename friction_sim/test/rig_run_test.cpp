@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 
@@ -85,120 +86,115 @@ ros::Subscriber listen(ros::NodeHandle& nh, const std::string& topic, Callback c
   return nh.subscribe<Message>(topic, 10000, boost::function<void(const typename Message::ConstPtr&)>(callback));
 }
 
-/// A controller given a bad protocol, in a namespace of its own whose simulator is a stop service that
-/// counts its calls (answered on a queue of its own while the controller runs).
-void runRefusedProtocol() {
-  const std::string protocol = "/tmp/friction_rig_bad_protocol.yaml";
-  std::FILE* file = std::fopen(protocol.c_str(), "w");
-  std::fputs("steps:\n  - {action: drive, speed: .nan, duration: -1.0}\nend: {global_events: 1}\n", file);
-  std::fclose(file);
-  ros::CallbackQueue queue;
-  ros::NodeHandle nh("/refused_protocol");
-  nh.setCallbackQueue(&queue);
-  const boost::function<bool(std_srvs::Trigger::Request&, std_srvs::Trigger::Response&)> count_stops =
-      [](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-        ++g_seen.stops_after_bad_protocol;
-        response.success = true;
-        return true;
-      };
-  ros::ServiceServer stop = nh.advertiseService("stop", count_stops);
-  ros::AsyncSpinner spinner(1, &queue);
-  spinner.start();
-  g_seen.bad_protocol_status = runCommand(
-      "rosrun friction_sim stage_controller __name:=controller __ns:=/refused_protocol _protocol:=" + protocol,
-      g_seen.bad_protocol_output);
-  spinner.stop();
-}
-
-/// A controller whose simulator refuses every command: a stand-in in a namespace of its own that
-/// announces t = 0, refuses what it is sent and counts the calls to stop and to unpause.
-void runProtocolAgainstARefusingSimulator(const std::string& protocol) {
-  ros::CallbackQueue queue;
-  ros::NodeHandle nh("/refused_command");
-  nh.setCallbackQueue(&queue);
-  const boost::function<bool(friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response&)>
-      refuse = [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
-        response.accepted = false;
-        response.reason = "speed 2 m/s exceeds the stage's max_speed 1 m/s";
-        return true;
-      };
-  const boost::function<bool(std_srvs::Trigger::Request&, std_srvs::Trigger::Response&)> count_stops =
-      [](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-        ++g_seen.stops_after_refused_command;
-        response.success = true;
-        return true;
-      };
-  const boost::function<bool(std_srvs::SetBool::Request&, std_srvs::SetBool::Response&)> count_unpauses =
-      [](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
-        if (!request.data) ++g_seen.unpauses_after_refused_command;
-        response.success = true;
-        return true;
-      };
-  ros::ServiceServer commands = nh.advertiseService("send_command", refuse);
-  ros::ServiceServer stop = nh.advertiseService("stop", count_stops);
-  ros::ServiceServer pause = nh.advertiseService("pause", count_unpauses);
-  ros::Publisher state = nh.advertise<friction_msgs::StageState>("stage_state", 1, true);
-  friction_msgs::StageState waiting;
-  waiting.normal_force = 1920.0;
-  waiting.paused = true;
-  state.publish(waiting);
-  ros::AsyncSpinner spinner(1, &queue);
-  spinner.start();
-  g_seen.refused_command_status = runCommand(
-      "rosrun friction_sim stage_controller __name:=controller __ns:=/refused_command _start_delay:=0 _protocol:=" +
-          protocol,
-      g_seen.refused_command_output);
-  spinner.stop();
-}
-
-/// A controller whose simulator is reset while it waits to start: a stand-in that announces t = 0,
-/// takes every command and run end, and when first unpaused announces a reset with the time still 0
-/// (the count of resets alone shows it), then, unpaused again, the protocol's end (two global events).
-void runControllerThroughAResetAtTheStart(const std::string& protocol) {
-  ros::CallbackQueue queue;
-  ros::NodeHandle nh("/reset_at_start");
-  nh.setCallbackQueue(&queue);
-  ros::Publisher state = nh.advertise<friction_msgs::StageState>("stage_state", 1, true);
-  auto announce = [&state](std::uint32_t resets, double time, std::uint32_t global_events, bool paused) {
+/// A stand-in for the simulator, in a namespace of its own, for a controller run against it: its
+/// services and its stage_state answer on a queue of their own while the controller runs.
+class StandInSimulator {
+ public:
+  explicit StandInSimulator(const std::string& ns) : ns_(ns), nh_(ns) {
+    nh_.setCallbackQueue(&queue_);
+    state_ = nh_.advertise<friction_msgs::StageState>("stage_state", 1, true);
+  }
+  /// Answers the service `name` with `reply` (which fills the response) and true.
+  template <class Service>
+  void answer(const std::string& name,
+              std::function<void(typename Service::Request&, typename Service::Response&)> reply) {
+    const boost::function<bool(typename Service::Request&, typename Service::Response&)> callback =
+        [reply](typename Service::Request& request, typename Service::Response& response) {
+          reply(request, response);
+          return true;
+        };
+    services_.push_back(nh_.advertiseService(name, callback));
+  }
+  /// Counts the calls to its stop service in `stops`.
+  void countStops(int& stops) {
+    answer<std_srvs::Trigger>("stop", [&stops](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+      ++stops;
+      response.success = true;
+    });
+  }
+  /// Publishes its stage state (latched): F_Z = 1920 N at simulated `time`.
+  void announce(std::uint32_t resets, double time, std::uint32_t global_events, bool paused) {
     friction_msgs::StageState msg;
     msg.header.stamp = ros::Time(time);
     msg.normal_force = 1920.0;
     msg.resets = resets;
     msg.global_events = global_events;
     msg.paused = paused;
-    state.publish(msg);
-  };
-  const boost::function<bool(friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response&)>
-      take = [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
+    state_.publish(msg);
+  }
+  /// Runs the controller on `protocol` with `parameters` ("_name:=value ..."); its exit status.
+  int runController(const std::string& protocol, const std::string& parameters, std::string& output) {
+    ros::AsyncSpinner spinner(1, &queue_);
+    spinner.start();
+    const int status = runCommand("rosrun friction_sim stage_controller __name:=controller __ns:=" + ns_ + " " +
+                                      parameters + " _protocol:=" + protocol,
+                                  output);
+    spinner.stop();
+    return status;
+  }
+
+ private:
+  std::string ns_;
+  ros::CallbackQueue queue_;
+  ros::NodeHandle nh_;
+  ros::Publisher state_;
+  std::vector<ros::ServiceServer> services_;
+};
+
+/// A controller given a bad protocol, against a simulator that is only a stop service.
+void runRefusedProtocol() {
+  const std::string protocol = "/tmp/friction_rig_bad_protocol.yaml";
+  std::FILE* file = std::fopen(protocol.c_str(), "w");
+  std::fputs("steps:\n  - {action: drive, speed: .nan, duration: -1.0}\nend: {global_events: 1}\n", file);
+  std::fclose(file);
+  StandInSimulator simulator("/refused_protocol");
+  simulator.countStops(g_seen.stops_after_bad_protocol);
+  g_seen.bad_protocol_status = simulator.runController(protocol, "", g_seen.bad_protocol_output);
+}
+
+/// A controller whose simulator announces t = 0, refuses every command and counts the calls to stop
+/// and to unpause.
+void runProtocolAgainstARefusingSimulator(const std::string& protocol) {
+  StandInSimulator simulator("/refused_command");
+  simulator.answer<friction_msgs::SendStageCommand>(
+      "send_command", [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
+        response.accepted = false;
+        response.reason = "speed 2 m/s exceeds the stage's max_speed 1 m/s";
+      });
+  simulator.countStops(g_seen.stops_after_refused_command);
+  simulator.answer<std_srvs::SetBool>("pause", [](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
+    if (!request.data) ++g_seen.unpauses_after_refused_command;
+    response.success = true;
+  });
+  simulator.announce(0, 0.0, 0, true);
+  g_seen.refused_command_status =
+      simulator.runController(protocol, "_start_delay:=0", g_seen.refused_command_output);
+}
+
+/// A controller whose simulator is reset while it waits to start: the stand-in announces t = 0, takes
+/// every command and run end, and when first unpaused announces a reset with the time still 0 (the
+/// count of resets alone shows it), then, unpaused again, the protocol's end (two global events).
+void runControllerThroughAResetAtTheStart(const std::string& protocol) {
+  StandInSimulator simulator("/reset_at_start");
+  simulator.answer<friction_msgs::SendStageCommand>(
+      "send_command", [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
         ++g_seen.commands_around_reset;
         response.accepted = true;
-        return true;
-      };
-  const boost::function<bool(friction_msgs::SetRunEnd::Request&, friction_msgs::SetRunEnd::Response&)> take_end =
-      [](friction_msgs::SetRunEnd::Request&, friction_msgs::SetRunEnd::Response& response) {
+      });
+  simulator.answer<friction_msgs::SetRunEnd>(
+      "set_run_end", [](friction_msgs::SetRunEnd::Request&, friction_msgs::SetRunEnd::Response& response) {
         ++g_seen.run_ends_around_reset;
         response.accepted = true;
-        return true;
-      };
-  const boost::function<bool(std_srvs::SetBool::Request&, std_srvs::SetBool::Response&)> unpause =
-      [&announce](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
-        if (!request.data && ++g_seen.unpauses_around_reset == 1) announce(1, 0.0, 0, true);
-        if (!request.data && g_seen.unpauses_around_reset == 2) announce(1, 0.1, 2, false);
+      });
+  simulator.answer<std_srvs::SetBool>(
+      "pause", [&simulator](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
+        if (!request.data && ++g_seen.unpauses_around_reset == 1) simulator.announce(1, 0.0, 0, true);
+        if (!request.data && g_seen.unpauses_around_reset == 2) simulator.announce(1, 0.1, 2, false);
         response.success = true;
-        return true;
-      };
-  ros::ServiceServer commands = nh.advertiseService("send_command", take);
-  ros::ServiceServer run_end = nh.advertiseService("set_run_end", take_end);
-  ros::ServiceServer pause = nh.advertiseService("pause", unpause);
-  announce(0, 0.0, 0, true);
-  ros::AsyncSpinner spinner(1, &queue);
-  spinner.start();
+      });
+  simulator.announce(0, 0.0, 0, true);
   std::string output;
-  g_seen.reset_controller_status = runCommand(
-      "rosrun friction_sim stage_controller __name:=controller __ns:=/reset_at_start _start_delay:=0 _protocol:=" +
-          protocol,
-      output);
-  spinner.stop();
+  g_seen.reset_controller_status = simulator.runController(protocol, "_start_delay:=0", output);
 }
 
 bool bagReadable(const std::string& path) {

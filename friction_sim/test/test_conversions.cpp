@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "friction_sim/ros/conversions.h"
+#include "friction_sim/ros/node_parameters.h"
 #include "friction_sim/ros/precursor_detector.h"
 #include "friction_sim/ros/rig_simulator.h"
 #include "friction_sim/ros/stage_controller.h"

@@ -1,7 +1,7 @@
 #include "friction_sim/ros/precursor_detector.h"
 
 #include "friction_sim/ros/conversions.h"
-#include "friction_sim/ros/rig_simulator.h"
+#include "friction_sim/ros/node_parameters.h"
 #include "friction_sim/scene_io.h"
 
 namespace friction {
@@ -24,8 +24,7 @@ DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh) {
   private_nh.param("front_fit_nodes", options.front_fit_nodes, options.front_fit_nodes);
   private_nh.param("scene", options.scene_path, options.scene_path);
   private_nh.param("overrides", options.overrides, options.overrides);
-  const auto problems = validateDetectorOptions(options);
-  if (!problems.empty()) throw ConfigError("parameters of " + private_nh.getNamespace(), problems);
+  refuseParameters(private_nh, validateDetectorOptions(options));
   return options;
 }
 

@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "friction_sim/ros/node_parameters.h"
 #include "friction_sim/results_io.h"
 #include "friction_sim/scene_io.h"
 
@@ -27,21 +28,6 @@ bool due(double now, double& next, double rate) {
 
 }  // namespace
 
-std::vector<std::pair<std::string, std::string>> parseOverrides(const std::string& text,
-                                                                std::vector<std::string>& problems) {
-  std::vector<std::pair<std::string, std::string>> overrides;
-  std::istringstream stream(text);
-  for (std::string item; stream >> item;) {
-    const auto equals = item.find('=');
-    if (equals == std::string::npos || equals == 0) {
-      problems.push_back("~overrides: item '" + item + "' is not allowed; allowed: key=value, e.g. pusher.height=0.01");
-      continue;
-    }
-    overrides.emplace_back(item.substr(0, equals), item.substr(equals + 1));
-  }
-  return overrides;
-}
-
 std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   std::vector<std::string> problems;
   auto require = [&](bool ok, const std::string& name, double value, const std::string& allowed) {
@@ -60,9 +46,7 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
       {"lattice_rate", o.lattice_rate}, {"snapshot_rate", o.snapshot_rate}};
   for (const auto& [name, rate] : rates) require(std::isfinite(rate) && rate > 0.0, name, rate, "a rate > 0 Hz");
   if (o.frame_id.empty()) problems.push_back("~frame_id: empty; allowed: a frame name such as 'slider'");
-  std::vector<std::string> override_problems;
-  parseOverrides(o.overrides, override_problems);
-  problems.insert(problems.end(), override_problems.begin(), override_problems.end());
+  parseOverrides(o.overrides, problems);
   return problems;
 }
 
@@ -83,8 +67,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   pnh.param("frame_id", o.frame_id, o.frame_id);
   pnh.param("stop_at_scene_end", o.stop_at_scene_end, o.stop_at_scene_end);
   pnh.param("start_paused", o.start_paused, o.start_paused);
-  const auto problems = validateOptions(o);
-  if (!problems.empty()) throw ConfigError("parameters of " + pnh.getNamespace(), problems);
+  refuseParameters(pnh, validateOptions(o));
   return o;
 }
 

@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "friction_sim/ros/conversions.h"
-#include "friction_sim/yaml_fields.h"
+#include "friction_sim/ros/node_parameters.h"
 
 namespace friction {
 
@@ -29,8 +29,7 @@ ControllerOptions readControllerOptions(const ros::NodeHandle& private_nh) {
   ControllerOptions options;
   private_nh.param("protocol", options.protocol_path, options.protocol_path);
   private_nh.param("start_delay", options.start_delay, options.start_delay);
-  const auto problems = validateControllerOptions(options);
-  if (!problems.empty()) throw ConfigError("parameters of " + private_nh.getNamespace(), problems);
+  refuseParameters(private_nh, validateControllerOptions(options));
   return options;
 }
 

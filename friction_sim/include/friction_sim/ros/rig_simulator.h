@@ -85,9 +85,6 @@ struct SimulatorOptions {
 std::vector<std::string> validateOptions(const SimulatorOptions& options);
 /// Reads the options from the private parameters; throws ConfigError listing every problem.
 SimulatorOptions readSimulatorOptions(const ros::NodeHandle& private_nh);
-/// Splits "key=value key=value" into pairs; problems for malformed items.
-std::vector<std::pair<std::string, std::string>> parseOverrides(const std::string& text,
-                                                                std::vector<std::string>& problems);
 /// Why a command must be refused (empty = acceptable).
 std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulation& simulation);
 
