@@ -442,6 +442,15 @@ def kernels_discussion(median):
         "same, and the smaller lattices cost the same in groups as one step at a time. One step at "
         "a time (`latticeStepOneAtATime`) the 10⁶-node lattice costs %.2f ns per node-step, and %.2f at "
         "57 × 31." % (median["latticeStepOneAtATime/1001/1001"], median["latticeStepOneAtATime/57/31"]),
+        "Each geometric bond takes a square root and a division; the linearised springs, which take neither, "
+        "cost %.2f ns per node-step at 57 × 31 against %.2f: %.0f %% of the step is those two operations." % (
+            median["latticeStep/linearised/57/31"], median["latticeStep/geometric/57/31"],
+            100 * (1 - median["latticeStep/linearised/57/31"] / median["latticeStep/geometric/57/31"])),
+        "Tried by hand on 2026-11-25 on this machine (57 × 31, against 6.0 ns): the inverse square root from a "
+        "bit-level first guess and four Newton steps, vectorised, 6.85 ns (two steps, too few for double "
+        "precision, 5.88: the multiplies then take the divider's place); 256-bit vectors "
+        "(`-mprefer-vector-width=256`) 6.8 ns; the square roots and divisions in a loop of their own over the row, "
+        "12.4 ns. None was kept.",
         "The chain driven at its side (pmma_1d_side) is swept the same way: F_X, and with it every block's normal "
         "force, is known once block 0 is prepared, so each strip's friction is applied as soon as the strip is "
         "finished (driven from the top, F_X is a sum over every block and the chain keeps separate passes).",
