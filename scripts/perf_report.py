@@ -476,7 +476,7 @@ def kernels_discussion(median):
         "them by multiplies and adds costs as much (below): the step at 57 × 31 is bound by the host's "
         "divider." % (
             median["bondDividerFloor"], 100 * median["bondDividerFloor"] / median["latticeStep/geometric/57/31"]),
-        "The smallest lattice, 32 × 32 (10³ nodes), costs %.2f ns, %.2f× that median: by hand on 2026-11-25 "
+        "The smallest lattice, 32 × 32 (10³ nodes), costs %.2f ns, %.2f× the median of the lattices up to 449 × 241: by hand on 2026-11-25 "
         "(perf), its bond loops, runs of 31 and 32 bonds, cost 40 %% more per node than 57 × 31's." % (
             lattice["32/32"], lattice["32/32"] / smaller),
         "Tried by hand on 2026-11-25 (57 × 31, against 6.0 ns on that day's host): the inverse square root from a "
@@ -485,8 +485,10 @@ def kernels_discussion(median):
         "(`-mprefer-vector-width=256`) 6.8 ns; the square roots and divisions in a loop of their own over the row, "
         "12.4 ns. On 2026-11-25 too (against 6.06 ns): 1 − (1 + σ)^(−1/2), with σ the squared stretch, as its "
         "power series to the eighth degree (exact to 2⁻⁵³ below |σ| = 0.01, the square root beyond), 7.9 ns: "
-        "sixteen multiplies and adds per bond, which this build does not fuse, cost more than the divider. "
-        "None was kept.",
+        "sixteen multiplies and adds per bond, which this build does not fuse, cost more than the divider; "
+        "the bonds left over from whole vectors (7 of 31 at 32 × 32) in one masked AVX-512 vector rather than "
+        "GCC's narrower vector and single bonds, 9.0 ns at 32 × 32 (against 7.6) and 6.9 at 57 × 31: a lone "
+        "vector's square root and division are waited for, where the loop's overlap. None was kept.",
         "The chain driven at its side (pmma_1d_side) is swept the same way: F_X, and with it every block's normal "
         "force, is known once block 0 is prepared, so each strip's friction is applied as soon as the strip is "
         "finished (driven from the top, F_X is a sum over every block and the chain keeps separate passes).",
