@@ -49,9 +49,14 @@ def size_label(size):
     return size.replace("/", " × ")
 
 
+def run_length(size):
+    """The bonds in each of a lattice's runs of nx − 1 (the horizontal and diagonal families)."""
+    return int(size.split("/")[0]) - 1
+
+
 def left_over_bonds(size):
     """The bonds of each run of nx − 1 that are not in a whole 8-wide vector."""
-    return (int(size.split("/")[0]) - 1) % 8
+    return run_length(size) % 8
 
 
 def flatness(median, sizes):
@@ -423,7 +428,7 @@ def targets_section(median, repetitions, whole):
          "before 2026-11-25 did, the sizes lie up to %.0f %% from their median" % (
              100 * (distance if distance is not None else math.nan), million_over_thousand,
              size_label(LATTICE_SIZES[0]), size_label(REMAINDER_SIZE), remainder, remainder / sizes_median,
-             int(REMAINDER_SIZE.split("/")[0]) - 1, left_over_bonds(REMAINDER_SIZE),
+             run_length(REMAINDER_SIZE), left_over_bonds(REMAINDER_SIZE),
              100 * (distance_with_remainder if distance_with_remainder is not None else math.nan)),
          flat_verdict),
         ("1D chain, at most 2 ns per block-step (57 blocks, as pmma_1d_side)", kernel_cell("chainStep/57") +
@@ -452,8 +457,9 @@ def kernels_discussion(median):
     lattice = {size: median["latticeStep/geometric/" + size] for size in LATTICE_SIZES}
     sizes_median, _ = flatness(median, LATTICE_SIZES)
     remainder = median["latticeStep/geometric/" + REMAINDER_SIZE]
-    geometric = median["latticeStep/geometric/57/31"]
-    unhidden = geometric - median["latticeStep/linearised/57/31"]  # the divider's time the step shows
+    geometric, linearised = median["latticeStep/geometric/57/31"], median["latticeStep/linearised/57/31"]
+    divider = median["bondDividerFloor"]
+    unhidden = geometric - linearised  # the divider's time the step shows
     largest = lattice.pop("1001/1001")
     wide_rows = lattice.pop("1001/61")
     smaller = statistics.median(lattice.values())
@@ -515,27 +521,24 @@ def kernels_discussion(median):
         "same, and the smaller lattices cost the same in groups as one step at a time. One step at "
         "a time (`latticeStepOneAtATime`) the 10⁶-node lattice costs %.2f ns per node-step, and %.2f at "
         "57 × 31." % (median["latticeStepOneAtATime/1001/1001"], median["latticeStepOneAtATime/57/31"]),
-        "Each geometric bond takes a square root and a division; the linearised springs, which take neither, "
-        "cost %.2f ns per node-step at 57 × 31 against %.2f: %.0f %% of the step is those two operations." % (
-            median["latticeStep/linearised/57/31"], median["latticeStep/geometric/57/31"],
-            100 * (1 - median["latticeStep/linearised/57/31"] / median["latticeStep/geometric/57/31"])),
-        "Neither instruction is fully pipelined: the 57 × 31 lattice's square roots and divisions alone, in a "
-        "loop that does nothing else (`bondDividerFloor`), cost %.2f ns per node-step, %.0f %% of the step. "
-        "Without them the step costs the linearised springs' %.2f ns, so %.2f ns of the divider's time is not "
-        "hidden under the rest of the step%s; replacing the two operations by multiplies and adds costs as "
-        "much (below)." % (
-            median["bondDividerFloor"], 100 * median["bondDividerFloor"] / median["latticeStep/geometric/57/31"],
-            median["latticeStep/linearised/57/31"], unhidden,
+        "Each geometric bond takes a square root and a division, neither instruction fully pipelined: the "
+        "57 × 31 lattice's square roots and divisions alone, in a loop that does nothing else "
+        "(`bondDividerFloor`), cost %.2f ns per node-step, %.0f %% of its %.2f ns step. Without them (the "
+        "linearised springs) the step costs %.2f ns, so %.2f ns (%.0f %% of the step) of the divider's time is "
+        "not hidden under the rest of the step%s; replacing the two operations by multiplies and adds costs "
+        "as much (below)." % (
+            divider, 100 * divider / geometric, geometric, linearised, unhidden, 100 * unhidden / geometric,
             ": reaching 5 ns here would need %.0f %% of that hidden" % (100 * (geometric - 5.0) / unhidden)
             if geometric > 5.0 and unhidden > 0 else ""),
         "The 10³-node lattices differ by their rows' width modulo 8: %s, whose runs of bonds are whole 8-wide "
         "vectors but for one bond, costs %.2f ns, and %s %.2f ns, %.2f× the median of the sizes in the targets "
         "table: by hand on 2026-11-25 (perf), its bond loops cost 40 %% more per node than 57 × 31's, GCC "
-        "finishing each run of 31 bonds with a 4-wide vector and three single bonds. Spread over a 1000-wide "
+        "finishing each run of %d bonds with a 4-wide vector and three single bonds. Spread over a 1000-wide "
         "row, the same left-over bonds would add about 1 %%: the flatness target above is read on the sizes "
         "without them, and does not hold with %s." % (
             size_label(LATTICE_SIZES[0]), median["latticeStep/geometric/" + LATTICE_SIZES[0]],
-            size_label(REMAINDER_SIZE), remainder, remainder / sizes_median, size_label(REMAINDER_SIZE)),
+            size_label(REMAINDER_SIZE), remainder, remainder / sizes_median, run_length(REMAINDER_SIZE),
+            size_label(REMAINDER_SIZE)),
         "Tried by hand on 2026-11-25 (57 × 31, against 6.0 ns on that day's host): the inverse square root from a "
         "bit-level first guess and four Newton steps, vectorised, 6.85 ns (two steps, too few for double "
         "precision, 5.88: the multiplies then take the divider's place); 256-bit vectors "
