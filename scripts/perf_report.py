@@ -455,7 +455,8 @@ def targets_section(median, repetitions, whole):
 # lost; a cell may be empty). The report prints these dated figures as given; it does not re-measure them.
 TRIED_AND_DROPPED = [
     ("prefetching the next strip's rows into the L2 cache while the current rows' forces are computed",
-     "10⁶ nodes, 2026-11-24, twice (interleaved A/B runs; the first pair fastest of 9)", "6.05 and 6.17", "5.34 and 5.64", ""),
+     "10⁶ nodes, 2026-11-24, twice (interleaved A/B runs; the first pair fastest of 9)", "6.05 and 6.17",
+     "5.34 and 5.64", ""),
     ("sweeping each row in chunks of 128 columns", "10⁶ nodes, 2026-11-24 (interleaved A/B runs)", "no change", "", ""),
     ("transparent huge pages for the state", "10⁶ nodes, 2026-11-24 (interleaved A/B runs)", "no change", "", ""),
     ("preparing the next rows in pieces between the current row's bond loops",
@@ -476,7 +477,8 @@ TRIED_AND_DROPPED = [
     ("one call per row for its four runs of bonds", "32 × 32, 2026-11-25", "7.6–8.2", "7.6–7.9", ""),
     ("two bonds' lengths inverted with one division (1/L₁ = L₂/(L₁L₂)), the horizontal with the diagonal and "
      "the vertical with the antidiagonal bonds", "57 × 31 and 449 × 241, 2026-11-25", "6.17–6.62 and 5.92–6.00",
-     "5.87–6.03 and 6.09–6.34", "slower at the default size, 3–5 % faster at 449 × 241; results change in round-off (not byte for byte)"),
+     "5.87–6.03 and 6.09–6.34",
+     "slower at the default size, 3–5 % faster at 449 × 241; results change in round-off (not byte for byte)"),
     ("a bound, not a change: the chain's viscous power not summed at all (the most that summing it inside the "
      "bond loop could save)", "chain, 57 blocks, 2026-11-25 (median of 5 interleaved runs, fastest – slowest)",
      "2.35 (2.26–2.49)", "2.46 (2.44–2.53)", "at most about 4 %; the chain's target needs 19 %"),
@@ -562,7 +564,8 @@ def kernels_discussion(median):
         "One step at a time (`latticeStepOneAtATime`) the 10⁶-node lattice costs %.2f ns per node-step, and "
         "%.2f at 57 × 31. Grouping cuts the memory traffic of the held and loading phases, not the stall of the "
         "first pass over each strip: with three steps per sweep, kick-and-drift took 21 %% of the step's profile "
-        "samples at 10⁶ nodes against 14 %% at 1001 × 61 (by hand, 2026-11-24)." % (median["latticeStepOneAtATime/1001/1001"], median["latticeStepOneAtATime/57/31"]),
+        "samples at 10⁶ nodes against 14 %% at 1001 × 61 (by hand, 2026-11-24)." % (
+            median["latticeStepOneAtATime/1001/1001"], median["latticeStepOneAtATime/57/31"]),
         "The 10³-node lattices differ by their rows' width modulo 8: %s, whose runs of bonds are whole 8-wide "
         "vectors but for one bond, costs %.2f ns, and %s %.2f ns, %.2f× the median of the sizes in the targets "
         "table: by hand on 2026-11-25 (perf), its bond loops cost 40 %% more per node than 57 × 31's, GCC "
