@@ -14,8 +14,9 @@ namespace {
 
 constexpr const char* kUsage = "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...";
 
-int usage() {
-  std::cerr << kUsage << "  (--help for more)\n";
+/// Refuses the command line, saying what is wrong with it.
+int usage(const std::string& problem) {
+  std::cerr << "friction_run: " << problem << "\n" << kUsage << "  (--help for more)\n";
   return 2;
 }
 
@@ -36,7 +37,7 @@ int run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") return help();
   }
-  if (argc < 2) return usage();
+  if (argc < 2) return usage("no scene file given");
   std::string scene_path = argv[1], out_dir;
   std::vector<std::pair<std::string, std::string>> overrides;
   for (int i = 2; i < argc; ++i) {
@@ -46,10 +47,12 @@ int run(int argc, char** argv) {
     } else if (arg == "--set" && i + 1 < argc) {
       const std::string assignment = argv[++i];
       const auto equals = assignment.find('=');
-      if (equals == std::string::npos) return usage();
+      if (equals == std::string::npos) return usage("--set needs key=value, got '" + assignment + "'");
       overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
+    } else if (arg == "--out" || arg == "--set") {
+      return usage(arg + " needs a value");
     } else {
-      return usage();
+      return usage("unknown argument '" + arg + "'");
     }
   }
   double stability_limit = 0.0;

@@ -1,0 +1,55 @@
+#!/usr/bin/python3
+"""The offline runner's command line: a bad argument or a bad override is refused before anything runs,
+with exit status 2 and a message that says what is wrong, and no results directory is written."""
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+import rosunit
+from catkin.find_in_workspaces import find_in_workspaces
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCENE = os.path.join(ROOT, "friction_sim/scenes/single_block.yaml")
+
+
+class FrictionRunCommandLineTest(unittest.TestCase):
+    def setUp(self):
+        runners = find_in_workspaces(["libexec"], project="friction_sim", path="friction_run", first_match_only=True)
+        self.assertTrue(runners, "friction_run is not built")
+        self.runner = runners[0]
+        self.work = tempfile.mkdtemp(prefix="friction_run_test_")
+        self.addCleanup(shutil.rmtree, self.work)
+        self.out = os.path.join(self.work, "out")
+
+    def refusal(self, *args):
+        """friction_run's exit status and standard error for `args`, after checking it wrote nothing."""
+        done = subprocess.run([self.runner] + list(args), capture_output=True, text=True, timeout=60)
+        self.assertFalse(os.path.exists(self.out), "a refused run wrote its results directory")
+        return done.returncode, done.stderr
+
+    def test_an_override_without_a_value_is_named(self):
+        status, message = self.refusal(SCENE, "--out", self.out, "--set", "pusher.height")
+        self.assertEqual(status, 2)
+        self.assertIn("--set needs key=value, got 'pusher.height'", message)
+
+    def test_an_unknown_argument_is_named(self):
+        status, message = self.refusal(SCENE, "--out", self.out, "--sett", "pusher.height=0.01")
+        self.assertEqual(status, 2)
+        self.assertIn("unknown argument '--sett'", message)
+
+    def test_an_option_missing_its_value_is_named(self):
+        status, message = self.refusal(SCENE, "--out", self.out, "--set")
+        self.assertEqual(status, 2)
+        self.assertIn("--set needs a value", message)
+
+    def test_a_bad_override_lists_the_field_the_value_and_the_range(self):
+        status, message = self.refusal(SCENE, "--out", self.out, "--set", "pusher.height=1")
+        self.assertNotEqual(status, 0)
+        self.assertIn("scene refused", message)
+        self.assertIn("pusher.height: value 1 is not allowed; allowed: [0,", message)
+
+
+if __name__ == "__main__":
+    rosunit.unitrun("friction_sim", "friction_run_command_line", FrictionRunCommandLineTest)
