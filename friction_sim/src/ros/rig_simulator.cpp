@@ -108,7 +108,7 @@ void RigSimulator::startSimulation() {
   pending_.clear();
   next_load_cells_ = next_gauges_ = next_frame_ = next_stage_state_ = next_clock_ = next_lattice_ = 0.0;
   next_snapshot_ = ros::WallTime::now();
-  pace_origin_wall_ = ros::WallTime::now();
+  pace_origin_wall_ = run_started_ = ros::WallTime::now();
   pace_origin_sim_ = 0.0;
   reset_requested_ = false;
   run_end_set_ = false;
@@ -296,8 +296,7 @@ void RigSimulator::pace() {
 }
 
 void RigSimulator::run() {
-  const auto start = ros::WallTime::now();
-  ros::WallTime next_spin = start;
+  ros::WallTime next_spin = ros::WallTime::now();
   std::string end_reason;
   while (!stop_ && !g_stop_requested && ros::ok()) {
     const ros::WallTime now = ros::WallTime::now();
@@ -345,9 +344,12 @@ void RigSimulator::run() {
     end_reason = reason.str();
   }
   publishStageState(simulation_->loadCells());
-  RunSummary summary = summarize(*simulation_, (ros::WallTime::now() - start).toSec());
+  // The summary is the run since the last reset: its simulated time and steps start there, and so does
+  // its wall time.
+  RunSummary summary = summarize(*simulation_, (ros::WallTime::now() - run_started_).toSec());
   summary.stop_reason = end_reason;
   printSummary(std::cout, summary);
+  if (resets_ > 0) std::cout << "  (the run since the last of " << resets_ << " reset(s))" << std::endl;
   if (bag_open_) {
     bag_.close();
     bag_open_ = false;

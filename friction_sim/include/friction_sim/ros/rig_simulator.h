@@ -36,7 +36,8 @@
 //                                                  ~stop_at_scene_end (a controller's end of its protocol,
 //                                                  so that a run ends where it should however fast it runs)
 //   pause (std_srvs/SetBool), reset (std_srvs/Trigger), stop (std_srvs/Trigger)
-//   A reset restarts the scene from t = 0 with the scene's stop condition, paused if ~start_paused.
+//   A reset restarts the scene from t = 0 with the scene's stop condition, paused if ~start_paused; the
+//   summary printed when the node ends is then the run since the last reset.
 //
 // Commands with NaN/inf, a normal load <= 0, a speed beyond the scene's stage.max_speed or an unknown
 // mode are refused with a logged reason; the simulation keeps running.
@@ -140,6 +141,7 @@ class RigSimulator {
   double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0,
          next_lattice_ = 0;
   ros::WallTime next_snapshot_, pace_origin_wall_;
+  ros::WallTime run_started_;  ///< when the simulation last started (at the node's start or a reset)
   double pace_origin_sim_ = 0.0;
   ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_;
   ros::Subscriber command_sub_;
