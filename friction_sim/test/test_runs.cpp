@@ -201,6 +201,14 @@ TEST(Determinism, AStopConditionSetDuringTheRunEndsItOnTheSameStepAsTheScenes) {
   bad = later;
   bad.stage_travel = 0.0;
   EXPECT_NE(changed.setStopCondition(bad).find("stage_travel 0 m is not allowed"), std::string::npos);
+  // All at once: each problem named in the one refusal.
+  bad.global_events = -1;
+  bad.time = std::nan("");
+  const std::string every_problem = changed.setStopCondition(bad);
+  for (const char* problem :
+       {"global_events -1 is not allowed", "time nan s is not allowed", "stage_travel 0 m is not allowed"}) {
+    EXPECT_NE(every_problem.find(problem), std::string::npos) << every_problem;
+  }
   EXPECT_EQ(changed.scene().stop.global_events, 2);
   EXPECT_TRUE(changed.finished());
 }

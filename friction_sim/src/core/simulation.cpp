@@ -427,13 +427,20 @@ void Simulation::checkStop() {
 }
 
 std::string Simulation::setStopCondition(const StopSpec& stop) {
+  // Every problem, separated by "; ", so that one refusal says all that must change.
   std::ostringstream reason;
+  const char* separator = "";
   if (stop.global_events < 0) {
     reason << "global_events " << stop.global_events << " is not allowed; allowed: >= 0 (0: not this condition)";
-  } else if (!(stop.time > 0.0)) {
-    reason << "time " << stop.time << " s is not allowed; allowed: > 0 s (inf: not this condition)";
-  } else if (!(stop.stage_travel > 0.0)) {
-    reason << "stage_travel " << stop.stage_travel << " m is not allowed; allowed: > 0 m (inf: not this condition)";
+    separator = "; ";
+  }
+  if (!(stop.time > 0.0)) {
+    reason << separator << "time " << stop.time << " s is not allowed; allowed: > 0 s (inf: not this condition)";
+    separator = "; ";
+  }
+  if (!(stop.stage_travel > 0.0)) {
+    reason << separator << "stage_travel " << stop.stage_travel
+           << " m is not allowed; allowed: > 0 m (inf: not this condition)";
   }
   if (!reason.str().empty()) return reason.str();
   scene_.stop = stop;
