@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""The offline runner's command line: a bad argument or a bad override is refused before anything runs,
-with exit status 2 and a message that says what is wrong, and no results directory is written."""
+"""The offline runner's command line: an argument it cannot read is refused with exit status 2, a bad
+override of a scene field with 3, each before anything runs, with a message that says what is wrong, and
+no results directory is written."""
 import os
 import shutil
 import subprocess
@@ -29,10 +30,19 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertFalse(os.path.exists(self.out), "a refused run wrote its results directory")
         return done.returncode, done.stderr
 
-    def test_an_override_without_a_value_is_named(self):
-        status, message = self.refusal(SCENE, "--out", self.out, "--set", "pusher.height")
+    def test_an_override_without_key_and_value_is_named(self):
+        for assignment in ["pusher.height", "=0.01", "pusher.height="]:
+            status, message = self.refusal(SCENE, "--out", self.out, "--set", assignment)
+            self.assertEqual(status, 2, assignment)
+            self.assertIn("--set needs key=value, got '%s'" % assignment, message)
+
+    def test_a_missing_scene_file_is_named(self):
+        status, message = self.refusal()
         self.assertEqual(status, 2)
-        self.assertIn("--set needs key=value, got 'pusher.height'", message)
+        self.assertIn("no scene file given", message)
+        status, message = self.refusal("--out", self.out, SCENE)
+        self.assertEqual(status, 2)
+        self.assertIn("the scene file comes first, got '--out'", message)
 
     def test_an_unknown_argument_is_named(self):
         status, message = self.refusal(SCENE, "--out", self.out, "--sett", "pusher.height=0.01")
@@ -40,13 +50,14 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertIn("unknown argument '--sett'", message)
 
     def test_an_option_missing_its_value_is_named(self):
-        status, message = self.refusal(SCENE, "--out", self.out, "--set")
-        self.assertEqual(status, 2)
-        self.assertIn("--set needs a value", message)
+        for option in ["--set", "--out"]:
+            status, message = self.refusal(SCENE, option)
+            self.assertEqual(status, 2, option)
+            self.assertIn("%s needs a value" % option, message)
 
     def test_a_bad_override_lists_the_field_the_value_and_the_range(self):
         status, message = self.refusal(SCENE, "--out", self.out, "--set", "pusher.height=1")
-        self.assertNotEqual(status, 0)
+        self.assertEqual(status, 3)
         self.assertIn("scene refused", message)
         self.assertIn("pusher.height: value 1 is not allowed; allowed: [0,", message)
 

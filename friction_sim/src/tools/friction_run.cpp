@@ -14,10 +14,13 @@ namespace {
 
 constexpr const char* kUsage = "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...";
 
-/// Refuses the command line, saying what is wrong with it.
-int usage(const std::string& problem) {
+/// Exit statuses: a command line that cannot be read, and a scene refused (SceneError).
+constexpr int kBadCommandLine = 2;
+constexpr int kSceneRefused = 3;
+
+int refuseCommandLine(const std::string& problem) {
   std::cerr << "friction_run: " << problem << "\n" << kUsage << "  (--help for more)\n";
-  return 2;
+  return kBadCommandLine;
 }
 
 int help() {
@@ -29,7 +32,8 @@ int help() {
                "  stresses.csv     per event, at onset and end: strain gauges and interface stresses\n"
                "  scene.yaml       the scene as run;  summary.txt  the summary, also printed\n\n"
                "  --set key=value  overrides one scene field, e.g. --set pusher.height=0.01 (SI units);\n"
-               "                   validated like the file: a bad scene is refused with every problem listed.\n";
+               "                   validated like the file: a bad scene is refused with every problem listed.\n\n"
+               "Exit status: 0 when the run ends, 2 for a command line it cannot read, 3 for a refused scene.\n";
   return 0;
 }
 
@@ -37,7 +41,8 @@ int run(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") return help();
   }
-  if (argc < 2) return usage("no scene file given");
+  if (argc < 2) return refuseCommandLine("no scene file given");
+  if (argv[1][0] == '-') return refuseCommandLine(std::string("the scene file comes first, got '") + argv[1] + "'");
   std::string scene_path = argv[1], out_dir;
   std::vector<std::pair<std::string, std::string>> overrides;
   for (int i = 2; i < argc; ++i) {
@@ -47,12 +52,14 @@ int run(int argc, char** argv) {
     } else if (arg == "--set" && i + 1 < argc) {
       const std::string assignment = argv[++i];
       const auto equals = assignment.find('=');
-      if (equals == std::string::npos) return usage("--set needs key=value, got '" + assignment + "'");
+      if (equals == std::string::npos || equals == 0 || equals + 1 == assignment.size()) {
+        return refuseCommandLine("--set needs key=value, got '" + assignment + "'");
+      }
       overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
     } else if (arg == "--out" || arg == "--set") {
-      return usage(arg + " needs a value");
+      return refuseCommandLine(arg + " needs a value");
     } else {
-      return usage("unknown argument '" + arg + "'");
+      return refuseCommandLine("unknown argument '" + arg + "'");
     }
   }
   double stability_limit = 0.0;
@@ -133,6 +140,6 @@ int main(int argc, char** argv) {
     return run(argc, argv);
   } catch (const friction::SceneError& error) {
     std::cerr << error.what() << "\n";
-    return 3;
+    return kSceneRefused;
   }
 }
