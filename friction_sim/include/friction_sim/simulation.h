@@ -88,8 +88,8 @@ class Simulation : public Dynamics {
   /// the spring mattress's plate is placed once, when F_Z is first applied.
   std::string checkNormalLoad(double normal_force) const;
   /// Replaces the scene's stop condition for the rest of the run (a controller's end of its protocol);
-  /// finished() is then that condition's. Returns the refusal reason, every problem in it, or empty:
-  /// global_events ≥ 0, time and stage_travel > 0 (∞ allowed).
+  /// finished() is then that condition's. Returns the refusal reason, its problems separated by " | ", or
+  /// empty: global_events ≥ 0, time and stage_travel > 0 (∞ allowed).
   std::string setStopCondition(const StopSpec& stop);
 
   const Scene& scene() const { return scene_; }

@@ -427,16 +427,17 @@ void Simulation::checkStop() {
 }
 
 std::string Simulation::setStopCondition(const StopSpec& stop) {
-  // Every problem, separated by "; ", so that one refusal says all that must change.
+  // Every problem, separated by " | " (a problem's own text holds "; "), so that one refusal says all that
+  // must change.
   std::ostringstream reason;
   const char* separator = "";
   if (stop.global_events < 0) {
     reason << "global_events " << stop.global_events << " is not allowed; allowed: >= 0 (0: not this condition)";
-    separator = "; ";
+    separator = " | ";
   }
   if (!(stop.time > 0.0)) {
     reason << separator << "time " << stop.time << " s is not allowed; allowed: > 0 s (inf: not this condition)";
-    separator = "; ";
+    separator = " | ";
   }
   if (!(stop.stage_travel > 0.0)) {
     reason << separator << "stage_travel " << stop.stage_travel
