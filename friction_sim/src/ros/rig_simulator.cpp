@@ -108,12 +108,12 @@ void RigSimulator::startSimulation() {
   pending_.clear();
   next_load_cells_ = next_gauges_ = next_frame_ = next_stage_state_ = next_clock_ = next_lattice_ = 0.0;
   next_snapshot_ = ros::WallTime::now();
-  pace_origin_wall_ = run_started_ = ros::WallTime::now();
-  pace_origin_sim_ = 0.0;
   reset_requested_ = false;
   run_end_set_ = false;
+  running_wall_time_ = 0.0;
+  paused_ = true;  // a new simulation runs once setPaused lets it, which starts its running time
   // A controller that started the rig paused sends its schedule again after a reset, then unpauses.
-  paused_ = options_.start_paused;
+  setPaused(options_.start_paused);
 }
 
 void RigSimulator::advertise() {
@@ -248,14 +248,25 @@ bool RigSimulator::onSendCommand(friction_msgs::SendStageCommand::Request& reque
 }
 
 bool RigSimulator::onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
-  paused_ = request.data;
+  setPaused(request.data);
   response.success = true;
   response.message = paused_ ? "paused" : "running";
-  if (!paused_) {
-    pace_origin_wall_ = ros::WallTime::now();
+  return true;
+}
+
+void RigSimulator::setPaused(bool paused) {
+  const ros::WallTime now = ros::WallTime::now();
+  if (paused && !paused_) running_wall_time_ += (now - running_since_).toSec();
+  if (!paused && paused_) running_since_ = now;
+  if (!paused) {
+    pace_origin_wall_ = now;
     pace_origin_sim_ = simulation_->time();
   }
-  return true;
+  paused_ = paused;
+}
+
+double RigSimulator::runningWallTime() const {
+  return running_wall_time_ + (paused_ ? 0.0 : (ros::WallTime::now() - running_since_).toSec());
 }
 
 bool RigSimulator::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
@@ -344,9 +355,9 @@ void RigSimulator::run() {
     end_reason = reason.str();
   }
   publishStageState(simulation_->loadCells());
-  // The summary is the run since the last reset: its simulated time and steps start there, and so does
-  // its wall time.
-  RunSummary summary = summarize(*simulation_, (ros::WallTime::now() - run_started_).toSec());
+  // The summary is the run since the last reset: its simulated time and steps start there, and its wall
+  // time is the time spent running since, not waiting paused (for a controller, or a user).
+  RunSummary summary = summarize(*simulation_, runningWallTime());
   summary.stop_reason = end_reason;
   printSummary(std::cout, summary);
   if (resets_ > 0) std::cout << "  (the run since the last of " << resets_ << " reset(s))" << std::endl;

@@ -37,7 +37,8 @@
 //                                                  so that a run ends where it should however fast it runs)
 //   pause (std_srvs/SetBool), reset (std_srvs/Trigger), stop (std_srvs/Trigger)
 //   A reset restarts the scene from t = 0 with the scene's stop condition, paused if ~start_paused; the
-//   summary printed when the node ends is then the run since the last reset.
+//   summary printed when the node ends is then the run since the last reset. Its wall time is the time
+//   spent running, not waiting paused.
 //
 // Commands with NaN/inf, a normal load <= 0, a speed beyond the scene's stage.max_speed or an unknown
 // mode are refused with a logged reason; the simulation keeps running.
@@ -119,6 +120,10 @@ class RigSimulator {
   bool onStop(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onSetRunEnd(friction_msgs::SetRunEnd::Request& request, friction_msgs::SetRunEnd::Response& response);
   void pace();
+  /// Pauses or runs the simulation, keeping the pace's origin and the wall time spent running.
+  void setPaused(bool paused);
+  /// s of wall time spent running (not paused) since the simulation last started.
+  double runningWallTime() const;
   template <class Message>
   void emit(ros::Publisher& publisher, const std::string& topic, const Message& msg);
 
@@ -141,7 +146,8 @@ class RigSimulator {
   double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0,
          next_lattice_ = 0;
   ros::WallTime next_snapshot_, pace_origin_wall_;
-  ros::WallTime run_started_;  ///< when the simulation last started (at the node's start or a reset)
+  double running_wall_time_ = 0.0;  ///< s, wall time spent running before running_since_
+  ros::WallTime running_since_;     ///< when the simulation last began running (unpaused)
   double pace_origin_sim_ = 0.0;
   ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_;
   ros::Subscriber command_sub_;
