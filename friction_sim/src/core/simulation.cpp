@@ -430,18 +430,15 @@ std::string Simulation::setStopCondition(const StopSpec& stop) {
   // Every problem, separated by " | " (a problem's own text holds "; "), so that one refusal says all that
   // must change.
   std::ostringstream reason;
-  const char* separator = "";
+  auto problem = [&reason]() -> std::ostream& { return reason << (reason.tellp() > 0 ? " | " : ""); };
   if (stop.global_events < 0) {
-    reason << "global_events " << stop.global_events << " is not allowed; allowed: >= 0 (0: not this condition)";
-    separator = " | ";
+    problem() << "global_events " << stop.global_events << " is not allowed; allowed: >= 0 (0: not this condition)";
   }
   if (!(stop.time > 0.0)) {
-    reason << separator << "time " << stop.time << " s is not allowed; allowed: > 0 s (inf: not this condition)";
-    separator = " | ";
+    problem() << "time " << stop.time << " s is not allowed; allowed: > 0 s (inf: not this condition)";
   }
   if (!(stop.stage_travel > 0.0)) {
-    reason << separator << "stage_travel " << stop.stage_travel
-           << " m is not allowed; allowed: > 0 m (inf: not this condition)";
+    problem() << "stage_travel " << stop.stage_travel << " m is not allowed; allowed: > 0 m (inf: not this condition)";
   }
   if (!reason.str().empty()) return reason.str();
   scene_.stop = stop;
