@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
     friction::PrecursorDetector detector{ros::NodeHandle(), private_nh, friction::readDetectorOptions(private_nh)};
     ros::spin();
   } catch (const friction::ConfigError& error) {
-    std::cerr << error.what() << std::endl;
+    std::cerr << ros::this_node::getName() << ": " << error.what() << std::endl;
     return 2;
   }
   return 0;

@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
     friction::RigSimulator simulator{ros::NodeHandle(), friction::readSimulatorOptions(ros::NodeHandle("~"))};
     simulator.run();
   } catch (const friction::ConfigError& error) {
-    std::cerr << error.what() << std::endl;
+    std::cerr << ros::this_node::getName() << ": " << error.what() << std::endl;
     return 2;
   }
   return 0;

@@ -14,7 +14,7 @@ int main(int argc, char** argv) {
     ros::spin();
     if (controller.failed()) return 2;
   } catch (const friction::ConfigError& error) {
-    std::cerr << error.what() << std::endl;
+    std::cerr << ros::this_node::getName() << ": " << error.what() << std::endl;
     // A simulator started paused waits for this node's protocol: end its run rather than leave it waiting.
     ros::NodeHandle nh;
     friction::stopSimulator(nh, ros::WallDuration(10.0));
