@@ -409,6 +409,7 @@ TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
   for (std::size_t e = 0; e < offline.events().size(); ++e) {
     EXPECT_EQ(offline.events()[e].onset_time, g_seen.events[e].onset_time);
     EXPECT_EQ(offline.events()[e].onset_shear_force, g_seen.events[e].onset_shear_force);
+    EXPECT_EQ(offline.events()[e].mean_shear_force, g_seen.events[e].mean_shear_force);
     EXPECT_EQ(offline.events()[e].node_slip, g_seen.events[e].node_slip);
   }
 }

@@ -53,6 +53,10 @@ TEST_P(SingleBlockStickSlip, MatchesTheClosedFormCycle) {
                 1e-6 * 2.0 * (mu_s - mu_k) * normal);
     EXPECT_NEAR(direction * event.end_shear_force, (2.0 * mu_k - mu_s) * normal,
                 1e-6 * std::abs((2.0 * mu_k - mu_s) * normal));
+    // The block is at rest at onset and end: the spring's mean force over the slip is the friction, µ_k·N.
+    EXPECT_NEAR(direction * event.mean_shear_force, mu_k * normal, 1e-6 * mu_k * normal);
+    // A sum over ~10⁵ steps: round-off of about 10⁵ × 1.1e-16.
+    EXPECT_NEAR(event.mean_normal_force, normal, 1e-9 * normal);
     const double slip_per_cycle = speed * slip_time + 2.0 * delta;
     EXPECT_NEAR(direction * event.node_slip[0], slip_per_cycle, 1e-6 * slip_per_cycle);
     if (e + 1 < events.size()) {

@@ -61,6 +61,8 @@ TEST(Conversions, SlipEventCarriesEveryQuantity) {
   event.onset_shear_force = 200.0;
   event.onset_normal_force = 1920.0;
   event.end_shear_force = 190.0;
+  event.mean_shear_force = 180.0;
+  event.mean_normal_force = 1921.0;
   event.nucleation_position = 0.0;
   event.slip_min_x = 0.0;
   event.slip_max_x = 0.05;
@@ -81,6 +83,8 @@ TEST(Conversions, SlipEventCarriesEveryQuantity) {
   EXPECT_EQ(back.index, 3);
   EXPECT_DOUBLE_EQ(back.onset_shear_force, 200.0);
   EXPECT_DOUBLE_EQ(back.end_shear_force, 190.0);
+  EXPECT_DOUBLE_EQ(back.mean_shear_force, 180.0);
+  EXPECT_DOUBLE_EQ(back.mean_normal_force, 1921.0);
   EXPECT_DOUBLE_EQ(back.rupture_length, 0.05);
   EXPECT_EQ(back.node_slip, event.node_slip);
   EXPECT_TRUE(std::isnan(back.first_unstick_time[2]));

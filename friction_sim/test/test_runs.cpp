@@ -365,6 +365,7 @@ Groups expectGroupedStepsGiveTheRunOfSingleSteps(const Scene& scene) {
     EXPECT_EQ(g.onset_shear_force, s.onset_shear_force);
     EXPECT_EQ(g.onset_normal_force, s.onset_normal_force);
     EXPECT_EQ(g.end_shear_force, s.end_shear_force);
+    EXPECT_EQ(g.mean_shear_force, s.mean_shear_force);
     EXPECT_EQ(g.global, s.global);
     EXPECT_EQ(g.node_slip, s.node_slip);
     EXPECT_TRUE(same_bits(g.first_unstick_time, s.first_unstick_time));

@@ -25,6 +25,8 @@ struct RunSummary {
   int single_node_precursors = 0;  ///< of those, events in which one node alone slipped (L_p = 0): no front ran
   std::vector<PrecursorPoint> precursor_points;
   double static_friction_macro = 0.0;  ///< µ_s,macro = F_X/F_Z at the first global event (NaN if none)
+  /// µ_k,macro = mean F_X / mean F_Z over the first global event, from onset to end (NaN if none)
+  double kinetic_friction_macro = 0.0;
   double simulated_time = 0.0;         ///< s
   long long steps = 0;
   double wall_time = 0.0;              ///< s

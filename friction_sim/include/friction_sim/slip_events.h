@@ -18,6 +18,11 @@ struct SlipEvent {
   double onset_shear_force = 0.0;   ///< N, F_X at onset (interpolated within the step)
   double onset_normal_force = 0.0;  ///< N, F_Z at onset
   double end_shear_force = 0.0;     ///< N, F_X at the end (interpolated within the step)
+  /// N, F_X averaged over time from onset to end; F_Z likewise. Their ratio over a global event is
+  /// µ_k,macro (MODEL.md §6): the slider is at rest before and after, so the pusher's mean force is the
+  /// interface's mean friction during the event (exactly µ_k·N for a single block).
+  double mean_shear_force = 0.0;
+  double mean_normal_force = 0.0;   ///< N
   double nucleation_position = 0.0;  ///< m, mean x of the nodes that unstuck first
   double slip_min_x = 0.0;          ///< m, smallest x of a node that slipped
   double slip_max_x = 0.0;          ///< m, largest x of a node that slipped
@@ -58,6 +63,9 @@ class SlipEventDetector {
   double longitudinal_speed_;
   bool in_event_ = false;
   SlipEvent current_;
+  double shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the current event so far
+  double normal_impulse_ = 0.0;  ///< N·s, ∫F_Z dt
+  double impulse_span_ = 0.0;    ///< s, the time those integrals cover
   std::vector<double> onset_u_;
   std::vector<SlipEvent> events_;
   int global_count_ = 0;

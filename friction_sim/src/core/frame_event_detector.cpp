@@ -35,14 +35,26 @@ std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents() {
   while (!ended_.empty() && ended_.front().end_time <= latest) {
     SlipEvent event = std::move(ended_.front());
     ended_.pop_front();
-    // The last samples taken at or before the onset and the end.
+    // The last samples taken at or before the onset and the end, and the forces' time averages
+    // (trapezoids) over the samples from the first of those to the second.
+    const LoadCellReading* previous = nullptr;
+    double shear_impulse = 0.0, normal_impulse = 0.0, span = 0.0;
     for (const LoadCellReading& reading : load_cells_) {
       if (reading.time <= event.onset_time) {
         event.onset_shear_force = reading.shear_force;
         event.onset_normal_force = reading.normal_force;
+        previous = &reading;
+      } else if (reading.time <= event.end_time && previous) {
+        const double interval = reading.time - previous->time;
+        shear_impulse += 0.5 * (previous->shear_force + reading.shear_force) * interval;
+        normal_impulse += 0.5 * (previous->normal_force + reading.normal_force) * interval;
+        span += interval;
+        previous = &reading;
       }
       if (reading.time <= event.end_time) event.end_shear_force = reading.shear_force;
     }
+    event.mean_shear_force = span > 0.0 ? shear_impulse / span : event.onset_shear_force;
+    event.mean_normal_force = span > 0.0 ? normal_impulse / span : event.onset_normal_force;
     ready.push_back(std::move(event));
   }
   // Keep the samples from the last one before any onset still to be resolved: those of ended and

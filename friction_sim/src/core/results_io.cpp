@@ -14,9 +14,11 @@ RunSummary summarize(const Simulation& simulation, double wall_time) {
   summary.stop_reason = simulation.stopReason();
   summary.events = static_cast<int>(simulation.events().size());
   summary.static_friction_macro = std::numeric_limits<double>::quiet_NaN();
+  summary.kinetic_friction_macro = std::numeric_limits<double>::quiet_NaN();
   for (const SlipEvent& event : simulation.events()) {
     if (event.global) {
       summary.static_friction_macro = event.onset_shear_force / event.onset_normal_force;
+      summary.kinetic_friction_macro = event.mean_shear_force / event.mean_normal_force;
       break;
     }
     ++summary.precursors;
@@ -50,13 +52,15 @@ void printSummary(std::ostream& out, const RunSummary& s) {
     out << "\n";
   }
   out << "  mu_s,macro = F_X/F_Z at the first global event: " << s.static_friction_macro << "\n"
+      << "  mu_k,macro = mean F_X / mean F_Z over that event: " << s.kinetic_friction_macro << "\n"
       << "  energy-balance residual (relative): " << std::setprecision(3) << s.relative_energy_residual << "\n";
 }
 
 void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, const Scene& scene) {
   out << "index,onset_time_s,end_time_s,onset_shear_force_N,onset_normal_force_N,shear_ratio,"
          "end_shear_force_N,nucleation_x_m,slip_min_x_m,slip_max_x_m,rupture_length_m,length_ratio,global,"
-         "median_front_speed_m_s,front_speed_over_c_s,front_speed_over_c_r,front_fits_left_out\n";
+         "median_front_speed_m_s,front_speed_over_c_s,front_speed_over_c_r,front_fits_left_out,"
+         "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio\n";
   out << std::setprecision(12);
   const double slider_length = scene.geometry.length;
   const WaveSpeeds speeds = waveSpeeds(scene);
@@ -68,6 +72,7 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
         << ',' << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << e.median_front_speed
         << ',' << e.median_front_speed / speeds.shear << ','
         << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out
+        << ',' << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.mean_shear_force / e.mean_normal_force
         << '\n';
   }
 }

@@ -563,7 +563,7 @@ std::uint64_t Simulation::stateHash() const {
   }
   for (const SlipEvent& event : events()) {
     const double numbers[] = {event.onset_time, event.end_time, event.onset_shear_force,
-                              event.rupture_length, event.nucleation_position};
+                              event.mean_shear_force, event.rupture_length, event.nucleation_position};
     mix(numbers, sizeof numbers);
     mix(event.node_slip.data(), sizeof(double) * event.node_slip.size());
   }

@@ -36,6 +36,9 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     for (int node : unstuck) current_.onset_time = std::min(current_.onset_time, transition_time(node));
     current_.onset_shear_force = shear_at(current_.onset_time);
     current_.onset_normal_force = loads.normal;
+    shear_impulse_ = 0.0;
+    normal_impulse_ = 0.0;
+    impulse_span_ = 0.0;
     current_.first_unstick_time.assign(n, kNaN);
     double sum = 0.0;
     for (int node : unstuck) sum += positions_[node];
@@ -47,9 +50,20 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
   for (int node : unstuck) {
     if (std::isnan(current_.first_unstick_time[node])) current_.first_unstick_time[node] = transition_time(node);
   }
-  if (contact.slidingCount() > 0) return false;
-  double end_time = contact.restuckLastStep().empty() ? step_start + dt : step_start;
-  for (int node : contact.restuckLastStep()) end_time = std::max(end_time, transition_time(node));
+  const bool ended = contact.slidingCount() == 0;
+  double end_time = step_start + dt;
+  if (ended && !contact.restuckLastStep().empty()) {
+    end_time = step_start;
+    for (int node : contact.restuckLastStep()) end_time = std::max(end_time, transition_time(node));
+  }
+  // The part of this step inside the event, F_X linear across the step as in shear_at.
+  const double from = std::max(step_start, current_.onset_time);
+  if (end_time > from) {
+    shear_impulse_ += 0.5 * (shear_at(from) + shear_at(end_time)) * (end_time - from);
+    normal_impulse_ += loads.normal * (end_time - from);
+    impulse_span_ += end_time - from;
+  }
+  if (!ended) return false;
   finish(end_time, u, shear_at(end_time));
   return true;
 }
@@ -59,6 +73,9 @@ void SlipEventDetector::finish(double end_time, const Vector& u, double end_shea
   SlipEvent& event = current_;
   event.end_time = end_time;
   event.end_shear_force = end_shear_force;
+  // Divided by the time integrated over, the sum of the same intervals as the integrals.
+  event.mean_shear_force = impulse_span_ > 0.0 ? shear_impulse_ / impulse_span_ : event.onset_shear_force;
+  event.mean_normal_force = impulse_span_ > 0.0 ? normal_impulse_ / impulse_span_ : event.onset_normal_force;
   const std::size_t n = positions_.size();
   event.node_slip.resize(n);
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;

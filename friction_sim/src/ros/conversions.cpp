@@ -80,6 +80,8 @@ friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>
   msg.onset_shear_force = event.onset_shear_force;
   msg.onset_normal_force = event.onset_normal_force;
   msg.end_shear_force = event.end_shear_force;
+  msg.mean_shear_force = event.mean_shear_force;
+  msg.mean_normal_force = event.mean_normal_force;
   msg.nucleation_position = event.nucleation_position;
   msg.slip_min_x = event.slip_min_x;
   msg.slip_max_x = event.slip_max_x;
@@ -106,6 +108,8 @@ SlipEvent fromMsg(const friction_msgs::SlipEvent& msg) {
   event.onset_shear_force = msg.onset_shear_force;
   event.onset_normal_force = msg.onset_normal_force;
   event.end_shear_force = msg.end_shear_force;
+  event.mean_shear_force = msg.mean_shear_force;
+  event.mean_normal_force = msg.mean_normal_force;
   event.nucleation_position = msg.nucleation_position;
   event.slip_min_x = msg.slip_min_x;
   event.slip_max_x = msg.slip_max_x;
