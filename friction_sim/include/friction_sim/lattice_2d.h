@@ -52,6 +52,9 @@ class Lattice2D : public Model {
   void releaseContact(SparseMatrix& stiffness, int node) const override;
   SparseMatrix dampingMatrix() const override;
   bool rebalanceLoad(const Vector& u) override;
+  /// Every bottom node's x (InterfaceLoading::Stuck), or only the middle one's, which takes out the
+  /// free slider's rigid translation and carries no force (InterfaceLoading::Free).
+  std::vector<int> blockedDofsDuringLoading() const override;
   void disconnectPusher() override { pusher_connected_ = false; }
   void connectPusher(const Vector& u) override;
   void setNormalLoad(double normal_force) override { normal_force_ = normal_force; }
@@ -90,6 +93,7 @@ class Lattice2D : public Model {
   std::vector<BondFamily> families_;
   double normal_force_;
   bool mattress_;
+  bool interface_free_while_loading_;
   double mattress_k_, mattress_kx_per_node_;
   double plate_z_ = 0.0;             ///< m, displacement of the mattress plate
   std::vector<double> top_anchor_x_;  ///< m, where the mattress holds each top node in x

@@ -15,6 +15,11 @@ namespace friction {
 enum class ModelKind { Lattice2D, Chain1D };
 enum class SpringForm { Geometric, Linearised };
 enum class TopLoadKind { Uniform, SpringMattress };
+/// How the interface moves tangentially while F_Z is applied (MODEL.md §2, loading protocol).
+enum class InterfaceLoading {
+  Stuck,  ///< held in x, as MODEL.md §2 step 1: the slider's blocked Poisson expansion stays in the interface as shear
+  Free,   ///< free in x (a lubricated placement): no shear stored; the nodes stick where the load left them
+};
 enum class ChainDriving { Side, Top };
 enum class FrictionLawKind { AmontonsCoulomb, SlipWeakening };
 enum class IntegratorKind { VelocityVerlet, RungeKutta4 };
@@ -62,6 +67,9 @@ struct FrictionSpec {
 struct LoadSpec {
   double normal_force = 1920.0;  ///< N, F_Z pressed on the top face (downwards)
   TopLoadKind top = TopLoadKind::Uniform;  ///< 2D only: how F_Z reaches the top row
+  /// The interface's tangential motion while F_Z is applied. 2D only in effect: the chain has no Poisson
+  /// expansion, so F_Z moves none of its blocks either way.
+  InterfaceLoading interface_while_loading = InterfaceLoading::Stuck;
   double mattress_stiffness = 0.0;  ///< N/m per top node, k_top (spring_mattress only; 0 = k)
   /// N/m, total horizontal stiffness of the mattress plate shared by the top nodes (0 = plate free in x)
   double mattress_horizontal_stiffness = 0.0;

@@ -37,6 +37,7 @@ Lattice2D::Lattice2D(const Scene& scene)
       geometric_(scene.lattice.spring_form == SpringForm::Geometric),
       normal_force_(scene.load.normal_force),
       mattress_(scene.load.top == TopLoadKind::SpringMattress),
+      interface_free_while_loading_(scene.load.interface_while_loading == InterfaceLoading::Free),
       mattress_k_(scene.load.mattress_stiffness > 0 ? scene.load.mattress_stiffness : k_),
       mattress_kx_per_node_(scene.load.mattress_horizontal_stiffness / nx_),
       top_anchor_x_(nx_, 0.0),
@@ -427,6 +428,11 @@ bool Lattice2D::rebalanceLoad(const Vector& u) {
   plate_z_ += correction;
   for (int i = 0; i < nx_; ++i) top_anchor_x_[i] = u[xDof(nodeIndex(i, nz_ - 1))];
   return std::abs(correction) > 1e-15 * spacing_;
+}
+
+std::vector<int> Lattice2D::blockedDofsDuringLoading() const {
+  if (interface_free_while_loading_) return {interfaceDof(nx_ / 2)};
+  return Model::blockedDofsDuringLoading();
 }
 
 void Lattice2D::connectPusher(const Vector& u) {

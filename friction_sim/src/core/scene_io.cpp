@@ -21,6 +21,8 @@ const EnumTable<SpringForm> kSpringFormNames{{SpringForm::Geometric, "geometric"
                                              {SpringForm::Linearised, "linearised"}};
 const EnumTable<TopLoadKind> kTopLoadNames{{TopLoadKind::Uniform, "uniform"},
                                            {TopLoadKind::SpringMattress, "spring_mattress"}};
+const EnumTable<InterfaceLoading> kInterfaceLoadingNames{{InterfaceLoading::Stuck, "stuck"},
+                                                         {InterfaceLoading::Free, "free"}};
 const EnumTable<ChainDriving> kDrivingNames{{ChainDriving::Side, "side"},
                                             {ChainDriving::Top, "top"}};
 const EnumTable<FrictionLawKind> kLawNames{{FrictionLawKind::AmontonsCoulomb, "amontons_coulomb"},
@@ -33,6 +35,7 @@ const EnumTable<StageMode> kStageModeNames{
 const EnumTable<ModelKind>& enumTable(ModelKind) { return kModelNames; }
 const EnumTable<SpringForm>& enumTable(SpringForm) { return kSpringFormNames; }
 const EnumTable<TopLoadKind>& enumTable(TopLoadKind) { return kTopLoadNames; }
+const EnumTable<InterfaceLoading>& enumTable(InterfaceLoading) { return kInterfaceLoadingNames; }
 const EnumTable<ChainDriving>& enumTable(ChainDriving) { return kDrivingNames; }
 const EnumTable<FrictionLawKind>& enumTable(FrictionLawKind) { return kLawNames; }
 const EnumTable<IntegratorKind>& enumTable(IntegratorKind) { return kSchemeNames; }
@@ -87,6 +90,7 @@ void visitScene(Scene& s, Visitor& v) {
   v.section("load", [&] {
     v.field("normal_force", s.load.normal_force);
     v.field("top", s.load.top);
+    v.field("interface_while_loading", s.load.interface_while_loading);
     v.field("mattress_stiffness", s.load.mattress_stiffness);
     v.field("mattress_horizontal_stiffness", s.load.mattress_horizontal_stiffness);
   });
