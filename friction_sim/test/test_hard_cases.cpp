@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -272,6 +273,16 @@ TEST(HardCases, UnresolvedWeakeningLengthIsWarned) {
   const auto warnings = sceneWarnings(scene);
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("shorter than one node spacing"), std::string::npos);
+  // Λ = (3E/8)·ξ_µ/((µ_s − µ_k)·F_Z/(L·B)): 0.1 mm of weakening makes a zone many spacings long.
+  const double zone = 3.0 / 8.0 * scene.material.youngs_modulus * 1e-4 /
+                      ((scene.friction.static_coefficient - scene.friction.kinetic_coefficient) *
+                       scene.load.normal_force / (scene.geometry.length * scene.geometry.width));
+  std::ostringstream expected;
+  expected.precision(3);
+  expected << "≈ " << zone << " m, spans " << zone / 0.005 << " node spacings (3 or more resolve it)";
+  EXPECT_NE(warnings[0].find(expected.str()), std::string::npos) << warnings[0] << "\nexpected: " << expected.str();
+  scene.friction.weakening_length = 1e-7;
+  EXPECT_NE(sceneWarnings(scene).at(0).find("not resolved, results depend on the lattice"), std::string::npos);
   scene.friction.weakening_length = 0.02;
   EXPECT_TRUE(sceneWarnings(scene).empty());
 }

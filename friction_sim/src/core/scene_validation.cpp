@@ -196,9 +196,25 @@ std::vector<std::string> sceneWarnings(const Scene& s) {
                                                          : s.geometry.length / std::max(s.chain.blocks - 1, 1);
   if (s.friction.law == FrictionLawKind::SlipWeakening && s.friction.weakening_length > 0.0 &&
       s.friction.weakening_length < spacing) {
+    // What the lattice must resolve is the cohesive zone, where the friction weakens, not ξ_µ itself: an
+    // estimate is Λ ≈ G·ξ_µ/((µ_s − µ_k)·σ̄), G the shear modulus (the chain's E: it only stretches) and
+    // σ̄ = F_Z/(L·B) the mean normal stress. The warning gives it so that the user can judge.
+    const double modulus = s.model == ModelKind::Lattice2D ? 3.0 / 8.0 * s.material.youngs_modulus
+                                                           : s.material.youngs_modulus;
+    const double mean_normal_stress = s.load.normal_force / (s.geometry.length * s.geometry.width);
+    const double strength_drop =
+        (s.friction.static_coefficient - s.friction.kinetic_coefficient) * mean_normal_stress;
     std::ostringstream text;
+    text.precision(3);
     text << "friction.weakening_length: " << s.friction.weakening_length << " m is shorter than one node spacing ("
-         << spacing << " m): the cohesive zone is not resolved and results depend on the lattice";
+         << spacing << " m)";
+    if (strength_drop > 0.0) {
+      const double cohesive_zone = modulus * s.friction.weakening_length / strength_drop;
+      text << "; the cohesive zone it sets, G·ξ_µ/((µ_s − µ_k)·σ̄) ≈ " << cohesive_zone << " m, spans "
+           << cohesive_zone / spacing << " node spacings"
+           << (cohesive_zone < 3.0 * spacing ? ": not resolved, results depend on the lattice"
+                                             : " (3 or more resolve it)");
+    }
     warnings.push_back(text.str());
   }
   return warnings;
