@@ -46,6 +46,24 @@ TEST_F(SideDrivenChain, PrecursorsNucleateAtTheTrailingEdgeBeforeOneGlobalEvent)
   }
 }
 
+TEST(SideDrivenChainOnset, TheFrameBeforeUnstickingShowsTheNucleatingBlockAtItsThreshold) {
+  Simulation simulation(loadScene(scenePath("pmma_1d_side")));
+  while (!simulation.eventStartedLastStep()) simulation.step();
+  const Scene& scene = simulation.scene();
+  const InterfaceFrame after = simulation.interfaceFrame(), before = simulation.interfaceFrameBeforeUnsticking();
+  // The pushed block unstuck at τ/σ = µ_s and now slides against µ_k·N (Amontons–Coulomb).
+  EXPECT_EQ(after.state[0], static_cast<std::uint8_t>(ContactState::Sliding));
+  EXPECT_NEAR(after.shear_stress[0] / after.normal_stress[0], scene.friction.kinetic_coefficient, 1e-12);
+  EXPECT_EQ(before.state[0], static_cast<std::uint8_t>(ContactState::Stuck));
+  EXPECT_NEAR(before.shear_stress[0] / before.normal_stress[0], scene.friction.static_coefficient, 1e-12);
+  EXPECT_EQ(before.slip_velocity[0], 0.0);
+  // Every other block is as it is.
+  for (std::size_t node = 1; node < after.position.size(); ++node) {
+    EXPECT_EQ(before.friction_force[node], after.friction_force[node]) << "node " << node;
+    EXPECT_EQ(before.state[node], after.state[node]) << "node " << node;
+  }
+}
+
 TEST_F(SideDrivenChain, FirstPrecursorIsThePushedBlockAloneAtItsThreshold) {
   // Uniform load: the pushed block carries F_Z/N and holds until F_X = µ_s·F_Z/N; no other block moves.
   const Scene& scene = simulation_->scene();

@@ -88,6 +88,11 @@ class ContactInterface {
   double stepStartPosition(int node, const Vector& u) const {
     return start_positions_kept_ || just_unstuck_[node] ? start_u_[node] : u[dofs_[node]];
   }
+  /// N, the friction a node that unstuck in the last step held as it crossed its threshold: µ_s·N
+  /// against the direction it now slides.
+  double thresholdFriction(int node) const {
+    return -friction_mode_[node] * static_coefficient_[node] * normalForce(node);
+  }
   /// Nodes that unstuck (or slid off on returning contact) at the end of the last step.
   const std::vector<int>& unstuckLastStep() const { return unstuck_last_step_; }
   /// Nodes that re-stuck during the last step.

@@ -62,6 +62,10 @@ class Simulation : public Dynamics {
 
   LoadCellReading loadCells() const;
   InterfaceFrame interfaceFrame() const;
+  /// The interface frame with the nodes that unstuck in the last step as they were at their threshold
+  /// crossing, stuck with friction µ_s·N_i: at an event's onset, the loaded state that gave way (the
+  /// plain frame shows them already sliding, at µ_k·N_i under Amontons–Coulomb).
+  InterfaceFrame interfaceFrameBeforeUnsticking() const;
   GaugeProfile gaugeProfile() const;
   LatticeSnapshot snapshot() const;
   EnergyBudget energy() const;

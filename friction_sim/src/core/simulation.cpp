@@ -501,6 +501,18 @@ InterfaceFrame Simulation::interfaceFrame() const {
   return frame;
 }
 
+InterfaceFrame Simulation::interfaceFrameBeforeUnsticking() const {
+  InterfaceFrame frame = interfaceFrame();
+  const double area = model_->interfaceNodeArea();
+  for (int node : contact_.unstuckLastStep()) {
+    frame.state[node] = static_cast<std::uint8_t>(ContactState::Stuck);
+    frame.slip_velocity[node] = 0.0;
+    frame.friction_force[node] = contact_.thresholdFriction(node);
+    frame.shear_stress[node] = -frame.friction_force[node] / area;
+  }
+  return frame;
+}
+
 GaugeProfile Simulation::gaugeProfile() const {
   GaugeProfile profile;
   profile.time = time_;

@@ -75,10 +75,10 @@ int run(int argc, char** argv) {
   stresses_csv << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
                   "interface_normal_stress_Pa,interface_shear_stress_Pa\n";
   stresses_csv.precision(10);
-  // The stress state at an event's onset (the loaded state that gave way) and at its end.
-  auto record_stresses = [&](int event, const char* phase) {
+  // The stress state at an event's onset (the loaded state that gave way: the nodes that unstuck in the
+  // onset step at their thresholds) and at its end.
+  auto record_stresses = [&](int event, const char* phase, const friction::InterfaceFrame& frame) {
     const friction::GaugeProfile gauges = simulation.gaugeProfile();
-    const friction::InterfaceFrame frame = simulation.interfaceFrame();
     for (std::size_t i = 0; i < frame.position.size(); ++i) {
       const bool gauge = i < gauges.stress.sigma_zz.size() && gauges.position[i] == frame.position[i];
       stresses_csv << event << ',' << phase << ',' << simulation.time() << ',' << frame.position[i] << ','
@@ -98,10 +98,12 @@ int run(int argc, char** argv) {
     for (; next_sample <= after.time; next_sample += sample_interval) {
       loading.push_back(friction::interpolate(before, after, next_sample));
     }
-    if (simulation.eventStartedLastStep()) record_stresses(static_cast<int>(simulation.events().size()), "onset");
+    if (simulation.eventStartedLastStep()) {
+      record_stresses(static_cast<int>(simulation.events().size()), "onset", simulation.interfaceFrameBeforeUnsticking());
+    }
     if (simulation.eventEndedLastStep()) {
       const friction::SlipEvent& event = simulation.events().back();
-      record_stresses(event.index, "end");
+      record_stresses(event.index, "end", simulation.interfaceFrame());
       std::cout << "event " << event.index << " at t = " << event.onset_time << " s: F_X/F_Z = "
                 << event.onset_shear_force / event.onset_normal_force
                 << ", L_p/L = " << event.rupture_length / scene.geometry.length
