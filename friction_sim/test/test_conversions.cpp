@@ -22,7 +22,7 @@ TEST(Conversions, LoadCellsAreAWrenchWithFxAlongXAndFzAlongZ) {
   EXPECT_EQ(msg.header.stamp, ros::Time(0.25));
   EXPECT_EQ(msg.header.frame_id, "slider");
   EXPECT_DOUBLE_EQ(msg.wrench.force.x, 123.5);
-  EXPECT_DOUBLE_EQ(msg.wrench.force.z, 1920.0);
+  EXPECT_DOUBLE_EQ(msg.wrench.force.z, -1920.0);  // F_Z presses down: −z in REP 103
   EXPECT_DOUBLE_EQ(msg.wrench.force.y, 0.0);
   const LoadCellReading back = fromMsg(msg);
   EXPECT_DOUBLE_EQ(back.time, 0.25);

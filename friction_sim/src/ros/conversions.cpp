@@ -17,7 +17,7 @@ geometry_msgs::WrenchStamped toMsg(const LoadCellReading& reading, const std::st
   geometry_msgs::WrenchStamped msg;
   msg.header = header(reading.time, frame_id);
   msg.wrench.force.x = reading.shear_force;
-  msg.wrench.force.z = reading.normal_force;
+  msg.wrench.force.z = -reading.normal_force;
   return msg;
 }
 
@@ -25,7 +25,7 @@ LoadCellReading fromMsg(const geometry_msgs::WrenchStamped& msg) {
   LoadCellReading reading;
   reading.time = msg.header.stamp.toSec();
   reading.shear_force = msg.wrench.force.x;
-  reading.normal_force = msg.wrench.force.z;
+  reading.normal_force = -msg.wrench.force.z;
   return reading;
 }
 

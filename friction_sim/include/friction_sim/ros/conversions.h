@@ -24,7 +24,8 @@ namespace friction {
 /// Simulated time (s) as a ROS stamp.
 ros::Time toStamp(double sim_time);
 
-/// Load cells as a force sensor reports them: F_X in force.x, F_Z in force.z (pressing down is +).
+/// Load cells as the force that the loading stage and the normal-load frame apply to the slider, in the
+/// slider frame (REP 103, z up): force.x = F_X (a push along +x is +), force.z = −F_Z (pressing down).
 geometry_msgs::WrenchStamped toMsg(const LoadCellReading& reading, const std::string& frame_id);
 LoadCellReading fromMsg(const geometry_msgs::WrenchStamped& msg);
 

@@ -20,7 +20,7 @@
 //
 // Published topics (relative to the node's namespace; stamps are simulated time):
 //   /clock (rosgraph_msgs/Clock)                   simulated time; at 20 Hz of wall time while paused
-//   load_cells (geometry_msgs/WrenchStamped)       F_X in force.x, F_Z in force.z
+//   load_cells (geometry_msgs/WrenchStamped)       force on the slider: F_X in force.x, −F_Z in force.z
 //   strain_gauges (friction_msgs/StrainGaugeProfile)
 //   interface (friction_msgs/InterfaceState)       also at every step where a node unsticks or an event ends
 //   slip_events (friction_msgs/SlipEvent)          when an event ends
