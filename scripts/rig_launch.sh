@@ -2,9 +2,10 @@
 # Runs roslaunch with a private master bound to localhost on a free port, so that the rig neither
 # disturbs another ROS system on the machine nor listens on the network.
 #   scripts/rig_launch.sh launch/rig.launch [arg:=value]...
-# Exits 0 only if roslaunch and every node it ran ended cleanly: roslaunch itself exits 0 when a node
-# refuses its scene or protocol, so the nodes' exit codes are read from roslaunch's log afterwards and a
-# failing node is named, with status 1, so that scripts and sweeps can tell a refused run from a run.
+# Exit status: 0 only if roslaunch and every node it ran ended cleanly. roslaunch itself exits 0 when a
+# node refuses its scene or protocol or crashes, so the nodes' exit codes are read from roslaunch's log
+# afterwards and a failing node is named, with status 1, so that scripts and sweeps can tell a failed
+# run from a run. 130 when interrupted (Ctrl-C, kill, hang-up), after roslaunch has stopped every node.
 set -euo pipefail
 source "$(dirname "$0")/ros_env.sh"
 set +u; source "$RIG_WS/devel/setup.bash"; set -u
@@ -14,25 +15,42 @@ export ROS_HOME="${ROS_HOME:-$RIG_WS/ros_home}"
 echo "rig_launch: private master at $ROS_MASTER_URI; to reach it from another shell:"
 echo "  source $RIG_WS/devel/setup.bash; export ROS_MASTER_URI=$ROS_MASTER_URI ROS_IP=127.0.0.1"
 
-pid_file=$(mktemp)
-trap 'rm -f "$pid_file"' EXIT
-# roslaunch names its log after its pid. The subshell writes its pid and then becomes roslaunch, which
-# thus stays in the foreground, where Ctrl-C reaches it.
+launched_after=$(mktemp)
+trap 'rm -f "$launched_after"' EXIT
+# roslaunch runs as a job of its own, so that this script can read its log when it ends and pass on a
+# signal meanwhile; job control keeps it from starting with SIGINT ignored, as a script's background
+# jobs otherwise do. Every signal is passed on as SIGINT, on which roslaunch stops its nodes cleanly.
+set -m
+roslaunch --port "$port" "$@" &
+launch_pid=$!
+interrupted=0
+trap 'interrupted=1; kill -INT "$launch_pid" 2>/dev/null || true' INT TERM HUP
 launch_status=0
-( echo "$BASHPID" >"$pid_file"; exec roslaunch --port "$port" "$@" ) || launch_status=$?
+while :; do
+  launch_status=0
+  wait "$launch_pid" || launch_status=$?
+  kill -0 "$launch_pid" 2>/dev/null || break  # still running: the wait was cut short by a signal
+done
+if [ "$interrupted" -eq 1 ]; then
+  echo "rig_launch: interrupted" >&2
+  exit 130
+fi
 [ "$launch_status" -eq 0 ] || exit "$launch_status"
 
-launch_log=$(ls -t "${ROS_LOG_DIR:-$ROS_HOME/log}"/*/roslaunch-*-"$(cat "$pid_file")".log 2>/dev/null | head -n 1 || true)
+# roslaunch names its log after its pid.
+launch_log=$(find "${ROS_LOG_DIR:-$ROS_HOME/log}" -name "roslaunch-*-$launch_pid.log" -newer "$launched_after" \
+             2>/dev/null | head -n 1)
 if [ -z "$launch_log" ]; then
-  echo "rig_launch: roslaunch's log was not found, so the nodes' exit codes are unknown" >&2
-  exit 1
+  echo "rig_launch: roslaunch wrote no log (it launched nothing?), so no node's exit code was checked" >&2
+  exit 0
 fi
-# A node that ends by itself with a non-zero code is logged as
+# A node that ends by itself with a non-zero code, or is killed by a signal (a negative code), is logged
 #   process has died [pid 8609, exit code 2, cmd /path/to/stage_controller __name:=controller ...
-# Nodes stopped by roslaunch at shutdown are logged as killed, not as died.
-failures=$(grep -oE 'process has died \[pid [0-9]+, exit code [1-9][0-9]*, cmd [^ ]+' "$launch_log" |
-           sed -E 's|.*exit code ([0-9]+), cmd .*/([^/]+)$|\2 (exit code \1)|' || true)
+# Nodes that roslaunch stops at shutdown are logged as killed, not as died.
+failures=$(grep -oE 'process has died \[pid [0-9]+, exit code -?[1-9][0-9]*, cmd [^ ]+' "$launch_log" |
+           sed -E 's|.*exit code (-?[0-9]+), cmd .*/([^/]+)$|\2 (exit code \1)|' || true)
 if [ -n "$failures" ]; then
-  echo "rig_launch: failed: $(echo "$failures" | paste -sd, - | sed 's/,/, /g'); their messages are above" >&2
+  echo "rig_launch: failed: $(echo "$failures" | paste -sd, - | sed 's/,/, /g'); the reasons are above or in" \
+       "the nodes' logs in $(dirname "$launch_log")" >&2
   exit 1
 fi

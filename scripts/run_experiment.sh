@@ -13,12 +13,17 @@ out="$RIG_ROOT/results/experiment"
 mkdir -p "$out"
 # Nothing of an earlier run may pass for this one's if this run fails.
 rm -f "$out"/{run.bag,events.csv,loading_curve.png,precursors.png,slip_map.png}
-# roslaunch's chatter is filtered out (grep's status is not the rig's; rig_launch's is).
+# roslaunch's chatter is filtered out (grep's status is not the rig's; rig_launch's is). The filter
+# ignores Ctrl-C and reads on while rig_launch stops the rig: roslaunch must not lose its output midway.
 launch_statuses=(0 0)
-"$RIG_ROOT/scripts/rig_launch.sh" "$RIG_ROOT/launch/rig.launch" record:=true bag:="$out/run.bag" "$@" \
-  2>&1 | grep -vE '^\s*$|killing on exit|shutting down|^\S*\[1m|REQUIRED process|process has finished|log file:|Initiating shutdown|^=+|SUMMARY|PARAMETERS|NODES|auto-starting|^ \* |^    ' \
+"$RIG_ROOT/scripts/rig_launch.sh" "$RIG_ROOT/launch/rig.launch" record:=true bag:="$out/run.bag" "$@" 2>&1 \
+  | (trap '' INT; exec grep -vE '^\s*$|killing on exit|shutting down|^\S*\[1m|REQUIRED process|process has finished|log file:|Initiating shutdown|^=+|SUMMARY|PARAMETERS|NODES|auto-starting|^ \* |^    ') \
   || launch_statuses=("${PIPESTATUS[@]}")
-[ "${launch_statuses[0]}" -eq 0 ] || { echo "run_experiment: the rig failed (its reasons are above); no figures written" >&2; exit 1; }
+case "${launch_statuses[0]}" in
+  0) ;;
+  130) echo "run_experiment: interrupted; no figures written" >&2; exit 130 ;;
+  *) echo "run_experiment: the rig failed (its reasons are above); no figures written" >&2; exit 1 ;;
+esac
 [ -f "$out/run.bag" ] || { echo "run_experiment: no bag was written" >&2; exit 1; }
 set +u; source "$RIG_WS/devel/setup.bash"; set -u
 /usr/bin/python3 "$RIG_ROOT/friction_sim/scripts/rig_report" "$out/run.bag" --out "$out"

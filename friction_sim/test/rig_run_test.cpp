@@ -54,9 +54,10 @@ struct Observed {
   double time_after_bad_commands = 0.0;
   std::string bad_scene_output, bad_parameter_output, bad_protocol_output, bad_detector_output;
   int bad_scene_status = 0, bad_parameter_status = 0, bad_protocol_status = 0, bad_detector_status = 0;
-  int stops_after_bad_protocol = 0;
+  int aborts_after_bad_protocol = 0, stops_after_bad_protocol = 0;
   std::string refused_command_output;
-  int refused_command_status = 0, stops_after_refused_command = 0, unpauses_after_refused_command = 0;
+  int refused_command_status = 0, aborts_after_refused_command = 0, stops_after_refused_command = 0,
+      unpauses_after_refused_command = 0;
   int reset_controller_status = -1, commands_around_reset = 0, run_ends_around_reset = 0, unpauses_around_reset = 0;
 };
 Observed g_seen;
@@ -105,10 +106,10 @@ class StandInSimulator {
         };
     services_.push_back(nh_.advertiseService(name, callback));
   }
-  /// Counts the calls to its stop service in `stops`.
-  void countStops(int& stops) {
-    answer<std_srvs::Trigger>("stop", [&stops](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-      ++stops;
+  /// Counts the calls to its Trigger service `name` (stop, abort) in `calls`.
+  void countCalls(const std::string& name, int& calls) {
+    answer<std_srvs::Trigger>(name, [&calls](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+      ++calls;
       response.success = true;
     });
   }
@@ -148,12 +149,13 @@ void runRefusedProtocol() {
   std::fputs("steps:\n  - {action: drive, speed: .nan, duration: -1.0}\nend: {global_events: 1}\n", file);
   std::fclose(file);
   StandInSimulator simulator("/refused_protocol");
-  simulator.countStops(g_seen.stops_after_bad_protocol);
+  simulator.countCalls("abort", g_seen.aborts_after_bad_protocol);
+  simulator.countCalls("stop", g_seen.stops_after_bad_protocol);
   g_seen.bad_protocol_status = simulator.runController(protocol, "", g_seen.bad_protocol_output);
 }
 
-/// A controller whose simulator announces t = 0, refuses every command and counts the calls to stop
-/// and to unpause.
+/// A controller whose simulator announces t = 0, refuses every command and counts the calls to abort,
+/// stop and unpause.
 void runProtocolAgainstARefusingSimulator(const std::string& protocol) {
   StandInSimulator simulator("/refused_command");
   simulator.answer<friction_msgs::SendStageCommand>(
@@ -161,7 +163,8 @@ void runProtocolAgainstARefusingSimulator(const std::string& protocol) {
         response.accepted = false;
         response.reason = "speed 2 m/s exceeds the stage's max_speed 1 m/s";
       });
-  simulator.countStops(g_seen.stops_after_refused_command);
+  simulator.countCalls("abort", g_seen.aborts_after_refused_command);
+  simulator.countCalls("stop", g_seen.stops_after_refused_command);
   simulator.answer<std_srvs::SetBool>("pause", [](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
     if (!request.data) ++g_seen.unpauses_after_refused_command;
     response.success = true;
@@ -319,18 +322,20 @@ TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
   EXPECT_EQ(g_seen.bad_parameter_status, 2);
   EXPECT_NE(g_seen.bad_parameter_output.find("~load_cell_rate: value -1"), std::string::npos)
       << g_seen.bad_parameter_output;
-  // A refused protocol lists every problem, and the controller ends the run of the simulator that waits
-  // for it rather than leave it waiting.
+  // A refused protocol lists every problem, and the controller aborts the run of the simulator that waits
+  // for it rather than leave it waiting (the simulator then exits with status 4: test_rig_launch.py).
   EXPECT_EQ(g_seen.bad_protocol_status, 2);
   EXPECT_NE(g_seen.bad_protocol_output.find("protocol refused (2 problems)"), std::string::npos)
       << g_seen.bad_protocol_output;
-  EXPECT_EQ(g_seen.stops_after_bad_protocol, 1);
+  EXPECT_EQ(g_seen.aborts_after_bad_protocol, 1);
+  EXPECT_EQ(g_seen.stops_after_bad_protocol, 0);
   // A protocol the simulator refuses a command of is not run under what the simulator had before: the
-  // controller stops it without unpausing it, and exits with status 2.
+  // controller aborts its run without unpausing it, and exits with status 2.
   EXPECT_EQ(g_seen.refused_command_status, 2) << g_seen.refused_command_output;
   EXPECT_NE(g_seen.refused_command_output.find("refused: speed 2 m/s exceeds the stage's max_speed"), std::string::npos)
       << g_seen.refused_command_output;
-  EXPECT_EQ(g_seen.stops_after_refused_command, 1);
+  EXPECT_EQ(g_seen.aborts_after_refused_command, 1);
+  EXPECT_EQ(g_seen.stops_after_refused_command, 0);
   EXPECT_EQ(g_seen.unpauses_after_refused_command, 0);
 }
 

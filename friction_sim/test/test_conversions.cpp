@@ -13,7 +13,7 @@
 namespace friction {
 namespace {
 
-TEST(Conversions, LoadCellsAreAWrenchWithFxAlongXAndFzAlongZ) {
+TEST(Conversions, LoadCellsAreTheWrenchOnTheSliderWithFzPressingDown) {
   LoadCellReading reading;
   reading.time = 0.25;
   reading.shear_force = 123.5;
@@ -28,6 +28,10 @@ TEST(Conversions, LoadCellsAreAWrenchWithFxAlongXAndFzAlongZ) {
   EXPECT_DOUBLE_EQ(back.time, 0.25);
   EXPECT_DOUBLE_EQ(back.shear_force, 123.5);
   EXPECT_DOUBLE_EQ(back.normal_force, 1920.0);
+  // A bag recorded before load_cells followed REP 103 holds +F_Z: read as the same load.
+  geometry_msgs::WrenchStamped old = msg;
+  old.wrench.force.z = 1920.0;
+  EXPECT_DOUBLE_EQ(fromMsg(old).normal_force, 1920.0);
 }
 
 TEST(Conversions, InterfaceFrameRoundTrips) {

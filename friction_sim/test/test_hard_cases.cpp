@@ -266,7 +266,7 @@ TEST(HardCases, FastForwardAgreesWithFullDynamics) {
   }
 }
 
-TEST(HardCases, UnresolvedWeakeningLengthIsWarned) {
+TEST(HardCases, WeakeningLengthShorterThanASpacingIsWarnedWithItsCohesiveZone) {
   Scene scene = testing::coarseSliderScene();
   scene.friction.law = FrictionLawKind::SlipWeakening;
   scene.friction.weakening_length = 1e-4;  // 0.1 mm, far below l = 5 mm

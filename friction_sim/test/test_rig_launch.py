@@ -1,9 +1,12 @@
 #!/usr/bin/python3
-"""scripts/rig_launch.sh's exit status: roslaunch itself exits 0 when a node refuses its input, so the
-script reads the nodes' exit codes and fails, naming the node, when any node refused; a run that ends
-cleanly exits 0. Each launch brings up its own private master on a free port."""
+"""scripts/rig_launch.sh's exit status: roslaunch itself exits 0 when a node refuses its input or
+crashes, so the script reads the nodes' exit codes and fails, naming the node; a run that ends cleanly
+exits 0, an interrupted one 130 after every node has stopped. Each launch brings up its own private
+master on a free port."""
 import os
+import signal
 import subprocess
+import time
 import unittest
 
 import rosunit
@@ -12,6 +15,59 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 RIG_LAUNCH = os.path.join(ROOT, "scripts/rig_launch.sh")
 RIG = os.path.join(ROOT, "launch/rig.launch")
 SINGLE_BLOCK = os.path.join(ROOT, "friction_sim/scenes/single_block.yaml")
+
+
+def parent_pids():
+    """pid -> parent pid of every process."""
+    parents = {}
+    for entry in os.listdir("/proc"):
+        try:
+            with open("/proc/%s/stat" % entry) as stat:
+                parents[int(entry)] = int(stat.read().rsplit(")", 1)[1].split()[1])
+        except (ValueError, OSError):
+            continue
+    return parents
+
+
+def descendant_named(root, name):
+    """The pid of a process called `name` below `root`, or None."""
+    parents = parent_pids()
+    for pid in parents:
+        ancestor = parents.get(pid)
+        while ancestor and ancestor != root:
+            ancestor = parents.get(ancestor)
+        if ancestor == root:
+            try:
+                with open("/proc/%d/comm" % pid) as comm:
+                    if comm.read().strip() == name:
+                        return pid
+            except OSError:
+                continue
+    return None
+
+
+class SlowRun:
+    """The default experiment at a hundredth of real time, with its simulator's pid once it runs."""
+
+    def __enter__(self):
+        self.process = subprocess.Popen([RIG_LAUNCH, RIG, "real_time_factor:=0.01"], stdout=subprocess.PIPE,
+                                        stderr=subprocess.STDOUT, text=True)
+        deadline = time.time() + 60
+        self.simulator = None
+        while self.simulator is None and time.time() < deadline:
+            time.sleep(0.2)
+            self.simulator = descendant_named(self.process.pid, "rig_simulator")
+        time.sleep(2.0)  # past the controller's start delay: the run is under way
+        return self
+
+    def finish(self):
+        output, _ = self.process.communicate(timeout=120)
+        return self.process.returncode, output
+
+    def __exit__(self, *exc):
+        if self.process.poll() is None:
+            self.process.kill()
+            self.process.communicate()
 
 
 def launch(*args):
@@ -31,14 +87,36 @@ class RigLaunchStatusTest(unittest.TestCase):
         status, output = launch("protocol:=/nonexistent/protocol.yaml", "analysis:=false")
         self.assertEqual(status, 1, output)
         self.assertIn("/rig/controller: protocol refused", output)
-        self.assertIn("rig_launch: failed: stage_controller (exit code 2)", output)
+        # The controller aborts the simulator's run: the simulator's own status tells, whatever the
+        # order in which roslaunch sees the two nodes end.
+        self.assertIn("rig_simulator (exit code 4)", output)
+        self.assertIn("aborted by the abort service", output)
+
+    def test_a_crashed_simulator_fails_the_launch(self):
+        with SlowRun() as run:
+            self.assertIsNotNone(run.simulator, "the simulator did not start")
+            os.kill(run.simulator, signal.SIGSEGV)
+            status, output = run.finish()
+        self.assertEqual(status, 1, output)
+        self.assertIn("rig_launch: failed: rig_simulator (exit code -11)", output)
+
+    def test_an_interrupted_launch_stops_every_node_and_exits_130(self):
+        with SlowRun() as run:
+            self.assertIsNotNone(run.simulator, "the simulator did not start")
+            run.process.send_signal(signal.SIGTERM)
+            status, output = run.finish()
+        self.assertEqual(status, 130, output)
+        self.assertIn("rig_launch: interrupted", output)
+        # The simulator ended its run and wrote its summary: roslaunch stopped it, not the kill.
+        self.assertIn("interrupted by a signal", output)
+        self.assertFalse(os.path.exists("/proc/%d" % run.simulator), "the simulator outlived the launch")
 
     def test_a_run_that_reaches_its_stop_condition_succeeds(self):
         # The single block slips at µ_s·F_Z = 0.4 × 1920 N three times and stops (its scene's stop).
         status, output = launch("scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false")
         self.assertEqual(status, 0, output)
         self.assertIn("reached 3 global slip event(s)", output)
-        self.assertIn("mu_s,macro = F_X/F_Z at the first global event: 0.4", output)
+        self.assertRegex(output, r"mu_s,macro = F_X/F_Z at the first global event: 0\.4\n")
         self.assertNotIn("rig_launch: failed", output)
 
 

@@ -57,6 +57,9 @@ TEST(SideDrivenChainOnset, TheFrameBeforeUnstickingShowsTheNucleatingBlockAtItsT
   EXPECT_EQ(before.state[0], static_cast<std::uint8_t>(ContactState::Stuck));
   EXPECT_NEAR(before.shear_stress[0] / before.normal_stress[0], scene.friction.static_coefficient, 1e-12);
   EXPECT_EQ(before.slip_velocity[0], 0.0);
+  // Without the catch-up slip it was given for the rest of the onset step: it had not slipped before.
+  EXPECT_GT(after.slip[0], 0.0);
+  EXPECT_EQ(before.slip[0], 0.0);
   // Every other block is as it is.
   for (std::size_t node = 1; node < after.position.size(); ++node) {
     EXPECT_EQ(before.friction_force[node], after.friction_force[node]) << "node " << node;

@@ -93,6 +93,11 @@ class ContactInterface {
   double thresholdFriction(int node) const {
     return -friction_mode_[node] * static_coefficient_[node] * normalForce(node);
   }
+  /// Of the nodes in unstuckLastStep: this one landed on the track while moving, and crossed no threshold.
+  bool landedSliding(int node) const { return landed_sliding_[node] != 0; }
+  /// m, the slip of a node that unstuck in the last step as it unstuck, without the catch-up it was given
+  /// for the rest of the step.
+  double slipAtUnsticking(int node, const Vector& u) const { return stepStartPosition(node, u) - slip_origin_[node]; }
   /// Nodes that unstuck (or slid off on returning contact) at the end of the last step.
   const std::vector<int>& unstuckLastStep() const { return unstuck_last_step_; }
   /// Nodes that re-stuck during the last step.
@@ -159,6 +164,7 @@ class ContactInterface {
   std::vector<double> other_force_;  ///< N, tangential force on the node from everything but friction
   std::vector<double> slip_origin_;  ///< m
   std::vector<char> just_unstuck_;  ///< 1 for the nodes in unstuck_last_step_, else 0
+  std::vector<char> landed_sliding_;  ///< 1 for those of them that landed moving, else 0
   std::vector<int> unstuck_last_step_, restuck_last_step_;
   std::vector<double> transition_fraction_;
   std::int64_t attention_ = 0;  ///< nodes that needed a state rule at the last friction pass

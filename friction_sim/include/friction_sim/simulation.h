@@ -63,8 +63,10 @@ class Simulation : public Dynamics {
   LoadCellReading loadCells() const;
   InterfaceFrame interfaceFrame() const;
   /// The interface frame with the nodes that unstuck in the last step as they were at their threshold
-  /// crossing, stuck with friction µ_s·N_i: at an event's onset, the loaded state that gave way (the
-  /// plain frame shows them already sliding, at µ_k·N_i under Amontons–Coulomb).
+  /// crossing, stuck with friction µ_s·N_i and without the slip they were given for the rest of the step:
+  /// at an event's onset, the loaded state that gave way (the plain frame shows them already sliding, at
+  /// µ_k·N_i under Amontons–Coulomb). A node that landed on the track moving crossed no threshold and is
+  /// shown as it is.
   InterfaceFrame interfaceFrameBeforeUnsticking() const;
   GaugeProfile gaugeProfile() const;
   LatticeSnapshot snapshot() const;

@@ -19,8 +19,9 @@ struct SlipEvent {
   double onset_normal_force = 0.0;  ///< N, F_Z at onset
   double end_shear_force = 0.0;     ///< N, F_X at the end (interpolated within the step)
   /// N, F_X averaged over time from onset to end; F_Z likewise. Their ratio over a global event is
-  /// µ_k,macro (MODEL.md §6): the slider is at rest before and after, so the pusher's mean force is the
-  /// interface's mean friction during the event (exactly µ_k·N for a single block).
+  /// µ_k,macro (MODEL.md §6): where the slider is at rest before and after, the pusher's mean force is
+  /// the interface's mean friction during the event (exactly so for the chain, whose blocks stand still
+  /// when stuck: µ_k·N for a single block; nearly so for the lattice, whose bulk may still ring).
   double mean_shear_force = 0.0;
   double mean_normal_force = 0.0;   ///< N
   double nucleation_position = 0.0;  ///< m, mean x of the nodes that unstuck first

@@ -33,6 +33,7 @@ ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model
   other_force_.assign(n, 0.0);
   slip_origin_.assign(n, 0.0);
   just_unstuck_.assign(n, 0);
+  landed_sliding_.assign(n, 0);
   transition_fraction_.assign(n, 1.0);
   start_u_.assign(n, 0.0);
   start_v_.assign(n, 0.0);
@@ -61,6 +62,7 @@ void ContactInterface::reset(const Vector& u) {
     anchor_[node] = u[dofs_[node]];
     slip_origin_[node] = u[dofs_[node]];
     just_unstuck_[node] = 0;
+    landed_sliding_[node] = 0;
     clearLoad(node);
     refreshCoefficients(node);
   }
@@ -253,7 +255,8 @@ void ContactInterface::rotateLoads() {
 }
 
 bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node_mass) {
-  for (int node : unstuck_last_step_) just_unstuck_[node] = 0;  // also when no step came between updates
+  // Also when no step came between updates.
+  for (int node : unstuck_last_step_) just_unstuck_[node] = landed_sliding_[node] = 0;
   unstuck_last_step_.clear();
   const int n = size();
   // The last friction pass recorded every node's load and whether any node needs one of the rules
@@ -281,6 +284,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
       transition_fraction_[node] = 1.0;
       if (v[dof] != 0.0) {
         startSliding(node, v[dof] > 0.0 ? 1 : -1);
+        landed_sliding_[node] = 1;
       } else {
         stick(node, u);
       }

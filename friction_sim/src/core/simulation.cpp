@@ -505,8 +505,10 @@ InterfaceFrame Simulation::interfaceFrameBeforeUnsticking() const {
   InterfaceFrame frame = interfaceFrame();
   const double area = model_->interfaceNodeArea();
   for (int node : contact_.unstuckLastStep()) {
+    if (contact_.landedSliding(node)) continue;
     frame.state[node] = static_cast<std::uint8_t>(ContactState::Stuck);
     frame.slip_velocity[node] = 0.0;
+    frame.slip[node] = contact_.slipAtUnsticking(node, u_);
     frame.friction_force[node] = contact_.thresholdFriction(node);
     frame.shear_stress[node] = -frame.friction_force[node] / area;
   }

@@ -15,9 +15,10 @@ int main(int argc, char** argv) {
     if (controller.failed()) return 2;
   } catch (const friction::ConfigError& error) {
     std::cerr << ros::this_node::getName() << ": " << error.what() << std::endl;
-    // A simulator started paused waits for this node's protocol: end its run rather than leave it waiting.
+    // A simulator started paused waits for this node's protocol: end its run, as failed, rather than
+    // leave it waiting.
     ros::NodeHandle nh;
-    friction::stopSimulator(nh, ros::WallDuration(10.0));
+    friction::endSimulatorRun(nh, "abort", ros::WallDuration(10.0));
     return 2;
   }
   return 0;

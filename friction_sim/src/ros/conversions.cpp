@@ -1,5 +1,7 @@
 #include "friction_sim/ros/conversions.h"
 
+#include <cmath>
+
 namespace friction {
 
 ros::Time toStamp(double sim_time) { return ros::Time(sim_time); }
@@ -25,7 +27,8 @@ LoadCellReading fromMsg(const geometry_msgs::WrenchStamped& msg) {
   LoadCellReading reading;
   reading.time = msg.header.stamp.toSec();
   reading.shear_force = msg.wrench.force.x;
-  reading.normal_force = -msg.wrench.force.z;
+  // F_Z presses down (force.z < 0); bags recorded before 2026-11-25 hold +F_Z, read the same.
+  reading.normal_force = std::abs(msg.wrench.force.z);
   return reading;
 }
 

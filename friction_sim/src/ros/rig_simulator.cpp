@@ -129,6 +129,7 @@ void RigSimulator::advertise() {
   pause_srv_ = nh_.advertiseService("pause", &RigSimulator::onPause, this);
   reset_srv_ = nh_.advertiseService("reset", &RigSimulator::onReset, this);
   stop_srv_ = nh_.advertiseService("stop", &RigSimulator::onStop, this);
+  abort_srv_ = nh_.advertiseService("abort", &RigSimulator::onAbort, this);
   run_end_srv_ = nh_.advertiseService("set_run_end", &RigSimulator::onSetRunEnd, this);
 }
 
@@ -283,6 +284,11 @@ bool RigSimulator::onStop(std_srvs::Trigger::Request&, std_srvs::Trigger::Respon
   return true;
 }
 
+bool RigSimulator::onAbort(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response) {
+  aborted_ = true;
+  return onStop(request, response);
+}
+
 bool RigSimulator::onSetRunEnd(friction_msgs::SetRunEnd::Request& request, friction_msgs::SetRunEnd::Response& response) {
   StopSpec end;
   // Beyond int's range a count is never reached anyway.
@@ -350,7 +356,9 @@ void RigSimulator::run() {
   }
   if (end_reason.empty()) {
     std::ostringstream reason;
-    reason << (stop_ ? "stopped by the stop service" : g_stop_requested ? "interrupted by a signal" : "ROS shut down")
+    reason << (aborted_ ? "aborted by the abort service"
+               : stop_  ? "stopped by the stop service"
+               : g_stop_requested ? "interrupted by a signal" : "ROS shut down")
            << " at t = " << simulation_->time() << " s";
     end_reason = reason.str();
   }

@@ -33,10 +33,10 @@ ControllerOptions readControllerOptions(const ros::NodeHandle& private_nh) {
   return options;
 }
 
-bool stopSimulator(ros::NodeHandle& nh, ros::WallDuration wait) {
-  ros::ServiceClient client = nh.serviceClient<std_srvs::Trigger>("stop");
-  std_srvs::Trigger stop;
-  return client.waitForExistence(ros::Duration(wait.toSec())) && client.call(stop);
+bool endSimulatorRun(ros::NodeHandle& nh, const std::string& service, ros::WallDuration wait) {
+  ros::ServiceClient client = nh.serviceClient<std_srvs::Trigger>(service);
+  std_srvs::Trigger call;
+  return client.waitForExistence(ros::Duration(wait.toSec())) && client.call(call);
 }
 
 StageController::StageController(ros::NodeHandle nh, LoadingProtocol protocol, double start_delay)
@@ -66,9 +66,9 @@ void StageController::start(double time, double normal_force) {
   }
   if (refused > 0) {
     // The run would not be the protocol's: the simulator would go on under what it had before.
-    ROS_ERROR_STREAM("stage controller: " << refused << " command(s) of the protocol refused; stopping the simulator");
+    ROS_ERROR_STREAM("stage controller: " << refused << " command(s) of the protocol refused; aborting the run");
     failed_ = true;
-    stopSimulator(nh_, ros::WallDuration(5.0));
+    endSimulatorRun(nh_, "abort", ros::WallDuration(5.0));
     ros::shutdown();
     return;
   }
@@ -109,7 +109,7 @@ void StageController::onStageState(const friction_msgs::StageState::ConstPtr& ms
   ROS_INFO_STREAM("stage controller: protocol ended at t = " << time << " s after " << msg->global_events
                                                              << " global events"
                                                              << (simulator_ends_run_ ? "" : "; stopping the simulator"));
-  if (!simulator_ends_run_) stopSimulator(nh_, ros::WallDuration(5.0));
+  if (!simulator_ends_run_) endSimulatorRun(nh_, "stop", ros::WallDuration(5.0));
   ros::shutdown();
 }
 

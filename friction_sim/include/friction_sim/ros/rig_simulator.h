@@ -36,6 +36,11 @@
 //                                                  ~stop_at_scene_end (a controller's end of its protocol,
 //                                                  so that a run ends where it should however fast it runs)
 //   pause (std_srvs/SetBool), reset (std_srvs/Trigger), stop (std_srvs/Trigger)
+//   abort (std_srvs/Trigger)                       ends the run as stop does, and the node then exits with
+//                                                  status 4: what drives the run could not (a controller
+//                                                  whose protocol or command was refused)
+// Exit status: 0 when the run ended (its end, stop, a signal, ROS shut down), 2 when the scene or a
+// parameter is refused, 4 when the run was aborted.
 //   A reset restarts the scene from t = 0 with the scene's stop condition, paused if ~start_paused; the
 //   summary printed when the node ends is then the run since the last reset. Its wall time is the time
 //   spent running, not waiting paused.
@@ -98,8 +103,10 @@ class RigSimulator {
   /// Loads the scene (throws SceneError/ConfigError before anything is advertised).
   RigSimulator(ros::NodeHandle nh, SimulatorOptions options);
   ~RigSimulator();
-  /// Runs until the scene ends, `stop` is called, the node is shut down or a signal arrives.
+  /// Runs until the scene ends, `stop` or `abort` is called, the node is shut down or a signal arrives.
   void run();
+  /// The run was ended by the `abort` service.
+  bool aborted() const { return aborted_; }
 
  private:
   void advertise();
@@ -118,6 +125,7 @@ class RigSimulator {
   bool onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
   bool onReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onStop(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  bool onAbort(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onSetRunEnd(friction_msgs::SetRunEnd::Request& request, friction_msgs::SetRunEnd::Response& response);
   void pace();
   /// Pauses or runs the simulation, keeping the pace's origin and the wall time spent running.
@@ -139,6 +147,7 @@ class RigSimulator {
   bool bag_open_ = false;
   bool paused_ = false;
   bool stop_ = false;
+  bool aborted_ = false;
   bool reset_requested_ = false;
   bool run_end_set_ = false;  ///< set_run_end was called: the run ends when the simulation finishes
   std::uint32_t resets_ = 0;  ///< resets so far, in stage_state: a controller cannot always tell one by the time
@@ -151,7 +160,7 @@ class RigSimulator {
   double pace_origin_sim_ = 0.0;
   ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_;
   ros::Subscriber command_sub_;
-  ros::ServiceServer command_srv_, pause_srv_, reset_srv_, stop_srv_, run_end_srv_;
+  ros::ServiceServer command_srv_, pause_srv_, reset_srv_, stop_srv_, abort_srv_, run_end_srv_;
 };
 
 }  // namespace friction

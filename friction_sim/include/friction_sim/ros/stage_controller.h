@@ -9,16 +9,17 @@
 //   stage_state (friction_msgs/StageState)  simulated time, F_Z, stage travel, global event count
 // Services called:
 //   send_command (friction_msgs/SendStageCommand)  every scheduled command, stamped with its time; if the
-//                                                   simulator refuses one, the controller stops it and
+//                                                   simulator refuses one, the controller aborts its run and
 //                                                   exits with status 2 (the run would not be the protocol's)
 //   set_run_end (friction_msgs/SetRunEnd)           the protocol's end, so that the simulator ends the run
 //                                                   on the step where it is reached
 //   pause (std_srvs/SetBool)                        called with false once the schedule is sent, so
 //                                                   that a simulator started paused runs every command on time
 //   stop (std_srvs/Trigger)                        once an end condition of the protocol holds, if the
-//                                                   simulator did not take it through set_run_end; or when
-//                                                   the protocol, a parameter or a command is refused (the
-//                                                   node then exits with status 2, the problems listed)
+//                                                   simulator did not take it through set_run_end
+//   abort (std_srvs/Trigger)                       when the protocol, a parameter or a command is refused:
+//                                                   the simulator ends its run and exits with status 4, the
+//                                                   node with status 2, the problems listed
 //
 // Uses ROS time only (the stage state's stamps, i.e. simulated time). If time jumps backwards or the
 // stage state's reset count changes (a reset), it starts the protocol again from the new time.
@@ -48,15 +49,15 @@ std::vector<std::string> validateControllerOptions(const ControllerOptions& opti
 /// Reads the options from the private parameters; throws ConfigError listing every problem.
 ControllerOptions readControllerOptions(const ros::NodeHandle& private_nh);
 
-/// Asks the simulator in `nh`'s namespace to end its run, waiting up to `wait` for its stop service;
-/// false if the service did not appear or the call failed.
-bool stopSimulator(ros::NodeHandle& nh, ros::WallDuration wait);
+/// Calls the simulator's `service` in `nh`'s namespace, "stop" (end the run) or "abort" (end it as
+/// failed), waiting up to `wait` for it to appear; false if it did not or the call failed.
+bool endSimulatorRun(ros::NodeHandle& nh, const std::string& service, ros::WallDuration wait);
 
 class StageController {
  public:
   StageController(ros::NodeHandle nh, LoadingProtocol protocol, double start_delay);
-  /// The simulator refused a command of the protocol (or could not be reached): the node has stopped it
-  /// and shut down.
+  /// The simulator refused a command of the protocol (or could not be reached): the node has aborted its
+  /// run and shut down.
   bool failed() const { return failed_; }
 
  private:
