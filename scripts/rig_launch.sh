@@ -25,7 +25,6 @@ roslaunch --port "$port" "$@" &
 launch_pid=$!
 interrupted=0
 trap 'interrupted=1; kill -INT "$launch_pid" 2>/dev/null || true' INT TERM HUP
-launch_status=0
 while :; do
   launch_status=0
   wait "$launch_pid" || launch_status=$?

@@ -24,6 +24,8 @@ struct SlipEvent {
   /// when stuck: µ_k·N for a single block; nearly so for the lattice, whose bulk may still ring).
   double mean_shear_force = 0.0;
   double mean_normal_force = 0.0;   ///< N
+  /// mean F_X / mean F_Z (µ_k,macro over a global event)
+  double meanShearRatio() const { return mean_shear_force / mean_normal_force; }
   double nucleation_position = 0.0;  ///< m, mean x of the nodes that unstuck first
   double slip_min_x = 0.0;          ///< m, smallest x of a node that slipped
   double slip_max_x = 0.0;          ///< m, largest x of a node that slipped
@@ -66,7 +68,6 @@ class SlipEventDetector {
   SlipEvent current_;
   double shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the current event so far
   double normal_impulse_ = 0.0;  ///< N·s, ∫F_Z dt
-  double impulse_span_ = 0.0;    ///< s, the time those integrals cover
   std::vector<double> onset_u_;
   std::vector<SlipEvent> events_;
   int global_count_ = 0;

@@ -18,7 +18,7 @@ RunSummary summarize(const Simulation& simulation, double wall_time) {
   for (const SlipEvent& event : simulation.events()) {
     if (event.global) {
       summary.static_friction_macro = event.onset_shear_force / event.onset_normal_force;
-      summary.kinetic_friction_macro = event.mean_shear_force / event.mean_normal_force;
+      summary.kinetic_friction_macro = event.meanShearRatio();
       break;
     }
     ++summary.precursors;
@@ -72,7 +72,7 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
         << ',' << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << e.median_front_speed
         << ',' << e.median_front_speed / speeds.shear << ','
         << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out
-        << ',' << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.mean_shear_force / e.mean_normal_force
+        << ',' << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio()
         << '\n';
   }
 }

@@ -38,7 +38,6 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     current_.onset_normal_force = loads.normal;
     shear_impulse_ = 0.0;
     normal_impulse_ = 0.0;
-    impulse_span_ = 0.0;
     current_.first_unstick_time.assign(n, kNaN);
     double sum = 0.0;
     for (int node : unstuck) sum += positions_[node];
@@ -61,7 +60,6 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
   if (end_time > from) {
     shear_impulse_ += 0.5 * (shear_at(from) + shear_at(end_time)) * (end_time - from);
     normal_impulse_ += loads.normal * (end_time - from);
-    impulse_span_ += end_time - from;
   }
   if (!ended) return false;
   finish(end_time, u, shear_at(end_time));
@@ -73,9 +71,9 @@ void SlipEventDetector::finish(double end_time, const Vector& u, double end_shea
   SlipEvent& event = current_;
   event.end_time = end_time;
   event.end_shear_force = end_shear_force;
-  // Divided by the time integrated over, the sum of the same intervals as the integrals.
-  event.mean_shear_force = impulse_span_ > 0.0 ? shear_impulse_ / impulse_span_ : event.onset_shear_force;
-  event.mean_normal_force = impulse_span_ > 0.0 ? normal_impulse_ / impulse_span_ : event.onset_normal_force;
+  const double duration = end_time - event.onset_time;
+  event.mean_shear_force = duration > 0.0 ? shear_impulse_ / duration : event.onset_shear_force;
+  event.mean_normal_force = duration > 0.0 ? normal_impulse_ / duration : event.onset_normal_force;
   const std::size_t n = positions_.size();
   event.node_slip.resize(n);
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;

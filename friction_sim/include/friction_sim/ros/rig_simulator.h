@@ -39,11 +39,11 @@
 //   abort (std_srvs/Trigger)                       ends the run as stop does, and the node then exits with
 //                                                  status 4: what drives the run could not (a controller
 //                                                  whose protocol or command was refused)
-// Exit status: 0 when the run ended (its end, stop, a signal, ROS shut down), 2 when the scene or a
-// parameter is refused, 4 when the run was aborted.
 //   A reset restarts the scene from t = 0 with the scene's stop condition, paused if ~start_paused; the
 //   summary printed when the node ends is then the run since the last reset. Its wall time is the time
 //   spent running, not waiting paused.
+// Exit status: 0 when the run ended (its end, stop, a signal, ROS shut down), 2 when the scene or a
+// parameter is refused, 4 when the run was aborted.
 //
 // Commands with NaN/inf, a normal load <= 0, a speed beyond the scene's stage.max_speed or an unknown
 // mode are refused with a logged reason; the simulation keeps running.
