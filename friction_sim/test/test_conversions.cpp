@@ -143,6 +143,24 @@ TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
   EXPECT_NE(checkCommand(msg, simulation).find("mode 9 is unknown"), std::string::npos);
 }
 
+TEST(CommandChecks, AHoldIgnoresTheSpeedAndTargetItCarries) {
+  Scene scene;
+  scene.model = ModelKind::Chain1D;
+  scene.chain.blocks = 3;
+  Simulation simulation(scene);
+  friction_msgs::StageCommand msg;
+  msg.mode = friction_msgs::StageCommand::HOLD;
+  msg.speed = 5.0;  // beyond max_speed, and meaningless for a hold
+  msg.target = std::nan("");
+  ASSERT_EQ(checkCommand(msg, simulation), "");
+  const TimedCommand hold = fromMsg(msg);
+  EXPECT_EQ(hold.stage.mode, StageMode::Hold);
+  // Accepted means applied: the stage, driven at the scene's speed before, stands still after.
+  ASSERT_GT(std::abs(simulation.stage().velocity()), 0.0);
+  EXPECT_EQ(simulation.stage().command(hold.stage), "");
+  EXPECT_EQ(simulation.stage().velocity(), 0.0);
+}
+
 TEST(CommandChecks, NormalLoadChangesAreRefusedWithTheSpringMattress) {
   Scene scene;
   scene.lattice.nodes_x = 29;  // square cells of 5 mm in the default 140 × 75 mm slider

@@ -170,7 +170,8 @@ TimedCommand fromMsg(const friction_msgs::StageCommand& msg) {
       command.stage = {StageMode::Position, msg.speed, msg.target};
       break;
     default:
-      command.stage = {StageMode::Hold, msg.speed, msg.target};
+      // A hold has no speed or target: the message's fields are left over from the sender, not asked for.
+      command.stage = {StageMode::Hold, 0.0, 0.0};
       break;
   }
   return command;

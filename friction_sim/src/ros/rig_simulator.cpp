@@ -76,7 +76,6 @@ std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulatio
     return "mode " + std::to_string(msg.mode) + " is unknown; allowed: 0 VELOCITY, 1 HOLD, 2 POSITION, 3 NORMAL_LOAD";
   }
   if (msg.mode == friction_msgs::StageCommand::NORMAL_LOAD) return simulation.checkNormalLoad(msg.normal_force);
-  if (msg.mode == friction_msgs::StageCommand::HOLD) return {};
   return simulation.stage().checkCommand(fromMsg(msg).stage);
 }
 
