@@ -6,6 +6,7 @@
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/scene_io.h"
+#include "friction_sim/simulation.h"
 #include "test_helpers.h"
 
 namespace friction {
@@ -100,7 +101,23 @@ INSTANTIATE_TEST_SUITE_P(
                     "chain.initial_shear (length): value 2", "one force per block"},
         InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [3.0, 2.0, 1.0]}\n"
                     "friction: {interfacial_stiffness: 1.0e8}",
-                    "friction.interfacial_stiffness: value 100000000", "0 (rigid sticking) with a chain.initial_shear"}));
+                    "friction.interfacial_stiffness: value 100000000", "0 (rigid sticking) with a chain.initial_shear"},
+        // µ_s·F_Z/3 = 256 N per block: the first would slide at t = 0.
+        InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [400.0, 0.0, 0.0]}",
+                    "chain.initial_shear[0]: value 400", "|f| <= mu_s * w_0 = 256 N, the block's static threshold"}));
+
+TEST(SceneFiles, AShearProfileWithinTheStaticThresholdsIsHeldAsGiven) {
+  const Scene scene = parseScene(
+      "model: chain_1d\nchain: {blocks: 3, initial_shear: [250.0, 0.0, -250.0]}\nstage: {program: [{mode: hold}]}");
+  Simulation simulation(scene);
+  simulation.advance(1e-3);
+  const InterfaceFrame frame = simulation.interfaceFrame();
+  const std::vector<double> expected{250.0, 0.0, -250.0};
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(frame.state[i], 0) << "block " << i;
+    EXPECT_NEAR(frame.friction_force[i], expected[i], 1e-6) << "block " << i;
+  }
+}
 
 TEST(InvalidScene, UnstableTimeStepMessageGivesTheLimit) {
   const auto problems = problemsOf("integrator: {time_step: 1.0e-5}");
