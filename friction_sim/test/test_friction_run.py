@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The offline runner's command line: an argument it cannot read is refused with exit status 2, a bad
-override of a scene field with 3, each before anything runs, with a message that says what is wrong, and
-no results directory is written."""
+override of a scene field with 3, an output directory it cannot write with 4, each before anything runs,
+with a message that says what is wrong, and no results directory is written."""
 import os
 import shutil
 import subprocess
@@ -60,6 +60,14 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertEqual(status, 3)
         self.assertIn("scene refused", message)
         self.assertIn("pusher.height: value 1 is not allowed; allowed: [0,", message)
+
+    def test_an_output_directory_that_cannot_be_created_is_named(self):
+        blocker = os.path.join(self.work, "a_file")
+        open(blocker, "w").close()
+        self.out = os.path.join(blocker, "out")
+        status, message = self.refusal(SCENE, "--out", self.out)
+        self.assertEqual(status, 4)
+        self.assertIn("--out %s: cannot create the directory" % self.out, message)
 
 
 if __name__ == "__main__":

@@ -92,6 +92,13 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertIn("rig_simulator (exit code 4)", output)
         self.assertIn("aborted by the abort service", output)
 
+    def test_a_bag_that_cannot_be_written_is_refused_before_the_run(self):
+        status, output = launch("record:=true", "bag:=/nonexistent/dir/run.bag", "analysis:=false")
+        self.assertEqual(status, 1, output)
+        self.assertIn("~bag: value '/nonexistent/dir/run.bag' cannot be written", output)
+        self.assertIn("rig_launch: failed: rig_simulator (exit code 2)", output)
+        self.assertNotIn("slip events:", output)
+
     def test_a_crashed_simulator_fails_the_launch(self):
         with SlowRun() as run:
             self.assertIsNotNone(run.simulator, "the simulator did not start")

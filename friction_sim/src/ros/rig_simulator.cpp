@@ -86,11 +86,19 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
   scene_ = loadScene(options_.scene_path, overrides, &stability_limit_);
   for (const std::string& warning : sceneWarnings(scene_)) ROS_WARN_STREAM("scene: " << warning);
   wave_speeds_ = waveSpeeds(scene_);
-  startSimulation();
+  // Opened before the run starts: a bag that cannot be written is refused rather than found out after
+  // the loading solve, or lost at the end.
   if (!options_.bag_path.empty()) {
-    bag_.open(options_.bag_path, rosbag::bagmode::Write);
+    try {
+      bag_.open(options_.bag_path, rosbag::bagmode::Write);
+    } catch (const rosbag::BagException& error) {
+      throw ConfigError("parameters of " + ros::this_node::getName(),
+                        {"~bag: value '" + options_.bag_path + "' cannot be written (" + error.what() +
+                         "); allowed: a file path in a writable directory"});
+    }
     bag_open_ = true;
   }
+  startSimulation();
   advertise();
 }
 

@@ -14,9 +14,16 @@ namespace {
 
 constexpr const char* kUsage = "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...";
 
-/// Exit statuses: a command line that cannot be read, and a scene refused (SceneError).
+/// Exit statuses: a command line that cannot be read, a scene refused (SceneError), and an output
+/// directory that cannot be written.
 constexpr int kBadCommandLine = 2;
 constexpr int kSceneRefused = 3;
+constexpr int kOutputUnwritable = 4;
+
+int refuseOutput(const std::string& out_dir, const std::string& reason) {
+  std::cerr << "friction_run: --out " << out_dir << ": " << reason << "\n";
+  return kOutputUnwritable;
+}
 
 int refuseCommandLine(const std::string& problem) {
   std::cerr << "friction_run: " << problem << "\n" << kUsage << "  (--help for more)\n";
@@ -33,7 +40,8 @@ int help() {
                "  scene.yaml       the scene as run;  summary.txt  the summary, also printed\n\n"
                "  --set key=value  overrides one scene field, e.g. --set pusher.height=0.01 (SI units);\n"
                "                   validated like the file: a bad scene is refused with every problem listed.\n\n"
-               "Exit status: 0 when the run ends, 2 for a command line it cannot read, 3 for a refused scene.\n";
+               "Exit status: 0 when the run ends, 2 for a command line it cannot read, 3 for a refused scene,\n"
+               "4 when DIR cannot be written (checked before the run, and again for the files written after it).\n";
   return 0;
 }
 
@@ -66,12 +74,15 @@ int run(int argc, char** argv) {
   const friction::Scene scene = friction::loadScene(scene_path, overrides, &stability_limit);
   for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
   if (out_dir.empty()) out_dir = "results/" + scene.name;
-  std::filesystem::create_directories(out_dir);
+  std::error_code directory_error;
+  std::filesystem::create_directories(out_dir, directory_error);
+  if (directory_error) return refuseOutput(out_dir, "cannot create the directory (" + directory_error.message() + ")");
+  std::ofstream stresses_csv(out_dir + "/stresses.csv");
+  if (!stresses_csv) return refuseOutput(out_dir, "cannot create files in it");
 
   const auto start = std::chrono::steady_clock::now();
   friction::Simulation simulation(scene, stability_limit);
   std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
-  std::ofstream stresses_csv(out_dir + "/stresses.csv");
   stresses_csv << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
                   "interface_normal_stress_Pa,interface_shear_stress_Pa\n";
   stresses_csv.precision(10);
@@ -131,6 +142,9 @@ int run(int argc, char** argv) {
   const friction::RunSummary summary = friction::summarize(simulation, wall);
   friction::printSummary(summary_txt, summary);
   friction::printSummary(std::cout, summary);
+  for (std::ofstream* file : {&stresses_csv, &events_csv, &nodes_csv, &loading_csv, &scene_yaml, &summary_txt}) {
+    if (!file->flush()) return refuseOutput(out_dir, "a result file could not be written in full");
+  }
   std::cout << "results written to " << out_dir << "/\n";
   return 0;
 }
