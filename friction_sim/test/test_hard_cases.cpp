@@ -285,6 +285,11 @@ TEST(HardCases, WeakeningLengthShorterThanASpacingIsWarnedWithItsCohesiveZone) {
   EXPECT_NE(sceneWarnings(scene).at(0).find("not resolved, results depend on the lattice"), std::string::npos);
   scene.friction.weakening_length = 0.02;
   EXPECT_TRUE(sceneWarnings(scene).empty());
+  // No weakening length is Amontons–Coulomb under another name, which a user asking for weakening
+  // would not see in the results.
+  scene.friction.weakening_length = 0.0;
+  ASSERT_EQ(sceneWarnings(scene).size(), 1u);
+  EXPECT_NE(sceneWarnings(scene)[0].find("as amontons_coulomb does"), std::string::npos);
 }
 
 TEST(HardCases, LargeLatticeTakesAFewSteps) {

@@ -208,6 +208,10 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
 
 std::vector<std::string> sceneWarnings(const Scene& s) {
   std::vector<std::string> warnings;
+  if (s.friction.law == FrictionLawKind::SlipWeakening && s.friction.weakening_length == 0.0) {
+    warnings.push_back("friction.weakening_length: 0 m with friction.law slip_weakening drops the friction to mu_k "
+                       "at once, as amontons_coulomb does; give the slip distance xi_mu (m) over which it weakens");
+  }
   const double spacing = s.model == ModelKind::Lattice2D ? s.geometry.length / std::max(s.lattice.nodes_x - 1, 1)
                                                          : s.geometry.length / std::max(s.chain.blocks - 1, 1);
   if (s.friction.law == FrictionLawKind::SlipWeakening && s.friction.weakening_length > 0.0 &&
