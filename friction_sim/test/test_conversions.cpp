@@ -227,7 +227,7 @@ TEST(DetectorOptions, EveryBadParameterIsNamedWithValueAndRange) {
   EXPECT_NE(problems[2].find("~overrides: item 'broken'"), std::string::npos);
 }
 
-TEST(DetectorOptions, TheRunsSceneGivesTheModelsWaveSpeedsAndFitWindow) {
+TEST(DetectorOptions, TheRunsSceneGivesTheModelsWaveSpeedsFitWindowAndLength) {
   DetectorOptions options;
   const DetectorSettings without_scene = resolveDetectorSettings(options);
   const WaveSpeeds unknown = without_scene.wave_speeds;
@@ -235,12 +235,14 @@ TEST(DetectorOptions, TheRunsSceneGivesTheModelsWaveSpeedsAndFitWindow) {
   EXPECT_EQ(unknown.shear, 0.0);
   EXPECT_EQ(unknown.rayleigh, 0.0);
   EXPECT_EQ(without_scene.front_fit_nodes, 5);
+  EXPECT_EQ(without_scene.slider_length, 0.0);
   // MODEL.md §2 with the default numbers: c_S = √(3E/(8ρ)) ≈ 968 m/s, c_L ≈ 1677 m/s, c_R ≈ 0.919·c_S.
   options.scene_path = SCENE_DIR "/pmma_2d.yaml";
   const WaveSpeeds lattice = resolveDetectorSettings(options).wave_speeds;
   EXPECT_NEAR(lattice.shear, 968.2, 0.1);
   EXPECT_NEAR(lattice.longitudinal, 1677.05, 0.01);
   EXPECT_NEAR(lattice.rayleigh, 0.919 * lattice.shear, 1e-9);
+  EXPECT_EQ(resolveDetectorSettings(options).slider_length, 0.14);
   // The run's overrides apply: a quarter of the density doubles every speed.
   options.overrides = "material.density=300 instruments.front_fit_nodes=7";
   const DetectorSettings overridden = resolveDetectorSettings(options);
@@ -255,6 +257,10 @@ TEST(DetectorOptions, TheRunsSceneGivesTheModelsWaveSpeedsAndFitWindow) {
   const WaveSpeeds chain = resolveDetectorSettings(options).wave_speeds;
   EXPECT_NEAR(chain.shear, std::sqrt(3.0e9 / 1200.0), 1e-9);
   EXPECT_EQ(chain.rayleigh, 0.0);
+  // A single block's interface has no span: L comes from the scene, so that L_p/L is finite.
+  options.scene_path = SCENE_DIR "/single_block.yaml";
+  EXPECT_EQ(resolveDetectorSettings(options).slider_length, 0.14);
+  options.scene_path = SCENE_DIR "/pmma_1d_side.yaml";
   // A scene the simulator would refuse is refused here too.
   options.overrides = "material.density=-1";
   EXPECT_THROW(resolveDetectorSettings(options), ConfigError);

@@ -35,6 +35,7 @@ DetectorSettings resolveDetectorSettings(const DetectorOptions& options) {
     const Scene scene = loadScene(options.scene_path, parseOverrides(options.overrides, ignored));
     settings.wave_speeds = waveSpeeds(scene);
     settings.front_fit_nodes = scene.instruments.front_fit_nodes;
+    settings.slider_length = scene.geometry.length;
   }
   if (options.front_fit_nodes != 0) settings.front_fit_nodes = options.front_fit_nodes;
   return settings;
@@ -44,6 +45,7 @@ PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private
     : nh_(std::move(nh)), private_nh_(std::move(private_nh)) {
   const DetectorSettings settings = resolveDetectorSettings(options);
   wave_speeds_ = settings.wave_speeds;
+  slider_length_ = settings.slider_length;
   detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, wave_speeds_.longitudinal);
   events_pub_ = private_nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   points_pub_ = private_nh_.advertise<friction_msgs::PrecursorPoint>("precursor_points", 1000, true);
@@ -70,15 +72,16 @@ void PrecursorDetector::onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr
 void PrecursorDetector::onFrame(const friction_msgs::InterfaceState::ConstPtr& msg) {
   checkTime(msg->header.stamp);
   positions_ = msg->position;
+  frame_id_ = msg->header.frame_id;
   detector_->addFrame(fromMsg(*msg));
   publishCompleted();
 }
 
 void PrecursorDetector::publishCompleted() {
   for (const SlipEvent& event : detector_->takeCompletedEvents()) {
-    const double length = detector_->sliderLength();
-    events_pub_.publish(toMsg(event, positions_, length, wave_speeds_, "slider"));
-    points_pub_.publish(toPointMsg(event, length, "slider"));
+    const double length = slider_length_ > 0.0 ? slider_length_ : detector_->sliderLength();
+    events_pub_.publish(toMsg(event, positions_, length, wave_speeds_, frame_id_));
+    points_pub_.publish(toPointMsg(event, length, frame_id_));
     ROS_INFO_STREAM("precursor detector: event " << event.index << " F_X/F_Z = "
                                                  << event.onset_shear_force / event.onset_normal_force
                                                  << ", L_p/L = " << event.rupture_length / length

@@ -9,11 +9,13 @@
 //   scene (string, "")         the run's scene YAML: its model's wave speeds go into the events, so that
 //                              v_c/c_R and v_c/c_S can be read off them (the instruments do not tell
 //                              them, as a lab takes c_R of its PMMA from the literature); "" = unknown (0).
+//                              Its geometry.length is the L of L_p/L, as the simulator's; without it L is
+//                              the span of the interface nodes (none for a single block: L_p/L is NaN)
 //                              Validated as the simulator does (a 10^6-node lattice's takes ~15 s)
 //   overrides (string, "")     the run's scene overrides, "key=value key=value", as the simulator's
 // Subscribed topics (relative to the node's namespace):
 //   load_cells (geometry_msgs/WrenchStamped), interface (friction_msgs/InterfaceState)
-// Published topics (private):
+// Published topics (private), in the interface frames' frame_id:
 //   ~slip_events (friction_msgs/SlipEvent), ~precursor_points (friction_msgs/PrecursorPoint)
 //
 // Bad parameters or a refused scene end the node at start (exit status 2), every problem listed.
@@ -49,6 +51,7 @@ DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh);
 struct DetectorSettings {
   WaveSpeeds wave_speeds;    ///< m/s, the model's (all 0, unknown, without a scene)
   int front_fit_nodes = 5;  ///< the options' or the scene's
+  double slider_length = 0.0;  ///< m, L of L_p/L: the scene's geometry.length; 0 without a scene
 };
 /// Loads the options' scene, if any; throws ConfigError if it is refused.
 DetectorSettings resolveDetectorSettings(const DetectorOptions& options);
@@ -66,7 +69,9 @@ class PrecursorDetector {
   ros::NodeHandle nh_, private_nh_;
   std::unique_ptr<FrameEventDetector> detector_;
   WaveSpeeds wave_speeds_;
+  double slider_length_ = 0.0;  ///< m, the scene's L, or 0: the span of the interface nodes
   std::vector<double> positions_;
+  std::string frame_id_;  ///< the interface frames', for the events
   ros::Time last_stamp_;
   ros::Subscriber load_cells_sub_, interface_sub_;
   ros::Publisher events_pub_, points_pub_;
