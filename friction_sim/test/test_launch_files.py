@@ -1,0 +1,77 @@
+#!/usr/bin/python3
+"""The launch files as roslaunch reads them, without starting anything: rviz follows the rig's namespace
+(rig.rviz names /rig's topics and services, remapped to the rig's), and multi_machine.launch runs the
+simulator on the compute host and everything else, rviz included, on the workstation, with every
+argument of rig.launch passed on."""
+import os
+import re
+import unittest
+
+import roslaunch.config
+import rosunit
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+LAUNCH = os.path.join(ROOT, "launch")
+RIG_RVIZ = os.path.join(ROOT, "friction_rviz/config/rig.rviz")
+
+
+def load(launch_file, *args):
+    # Machines are not assigned: that would resolve the compute host's address.
+    return roslaunch.config.load_config_default([(os.path.join(LAUNCH, launch_file), list(args))], None,
+                                                assign_machines=False)
+
+
+def host(config, name):
+    """The address of the machine that runs node `name` ('' = this one, with no machine declared)."""
+    machine = node(config, name).machine_name
+    return config.machines[machine].address if machine else ""
+
+
+def node(config, name):
+    matches = [n for n in config.nodes if n.name == name]
+    assert len(matches) == 1, "%s: %d nodes named %s" % (config, len(matches), name)
+    return matches[0]
+
+
+def names_in_rig_rviz():
+    """The absolute topic names of rig.rviz's displays and the names its panel reaches in its namespace."""
+    with open(RIG_RVIZ) as config:
+        text = config.read()
+    topics = re.findall(r"^\s*Topic: (\S+)", text, re.M)
+    namespace = re.search(r"^\s*Namespace: (\S+)", text, re.M).group(1)
+    panel = ["load_cells", "slip_events", "stage_state", "send_command", "pause"]
+    return topics + [namespace + "/" + name for name in panel]
+
+
+class LaunchFilesTest(unittest.TestCase):
+    def check_rviz_follows(self, config, namespace):
+        remaps = dict(node(config, "rviz").remap_args)
+        for name in names_in_rig_rviz():
+            self.assertTrue(name.startswith("/rig/"), name)
+            self.assertEqual(remaps.get(name), "/%s/%s" % (namespace, name[len("/rig/"):]), name)
+
+    def test_rviz_follows_the_rigs_namespace_live_and_in_playback(self):
+        self.check_rviz_follows(load("rig.launch", "ns:=bench2", "rviz:=true"), "bench2")
+        self.check_rviz_follows(load("rig.launch", "rviz:=true"), "rig")
+        self.check_rviz_follows(load("playback.launch", "bag:=/tmp/run.bag", "ns:=replay", "rviz:=true"), "replay")
+
+    def test_multi_machine_runs_the_simulator_remotely_with_every_rig_argument(self):
+        config = load("multi_machine.launch", "compute_host:=hpc1", "compute_env:=/opt/rig/scripts/ros_env_loader.sh",
+                      "overrides:=pusher.height=0.01", "record:=true", "bag:=/scratch/run.bag",
+                      "real_time_factor:=0.5", "ns:=bench")
+        self.assertEqual(host(config, "simulator"), "hpc1")
+        self.assertEqual(node(config, "simulator").namespace, "/bench/")
+        for workstation_node in ["controller", "precursor_detector", "rviz"]:
+            self.assertEqual(host(config, workstation_node), "localhost", workstation_node)
+        self.assertEqual(config.params["/bench/simulator/overrides"].value, "pusher.height=0.01")
+        self.assertEqual(config.params["/bench/simulator/bag"].value, "/scratch/run.bag")
+        self.assertEqual(config.params["/bench/simulator/real_time_factor"].value, 0.5)
+        self.check_rviz_follows(config, "bench")
+
+    def test_the_rig_runs_on_this_machine_by_default(self):
+        config = load("rig.launch")
+        self.assertEqual(host(config, "simulator"), "")
+
+
+if __name__ == "__main__":
+    rosunit.unitrun("friction_sim", "launch_files", LaunchFilesTest)
