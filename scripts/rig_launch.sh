@@ -12,6 +12,9 @@ set +u; source "$RIG_WS/devel/setup.bash"; set -u
 port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI="http://127.0.0.1:$port" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1
 export ROS_HOME="${ROS_HOME:-$RIG_WS/ros_home}"
+# The nodes' log lines reach a pipe (a filter, a test, a file) as they are written and in order with
+# roslaunch's own, not in blocks when a node ends.
+export ROSCONSOLE_STDOUT_LINE_BUFFERED="${ROSCONSOLE_STDOUT_LINE_BUFFERED:-1}"
 echo "rig_launch: private master at $ROS_MASTER_URI; to reach it from another shell:"
 echo "  source $RIG_WS/devel/setup.bash; export ROS_MASTER_URI=$ROS_MASTER_URI ROS_IP=127.0.0.1"
 

@@ -31,9 +31,21 @@ NOISE = ("media_export", "librospack")  # Debian's rviz asks rospack for a packa
 
 
 def screenshot(path):
-    subprocess.run(["import", "-window", "root", path], check=True)
+    # PNG24: RGB even while the screen is one colour, before rviz draws (a grey PNG would have one channel).
+    subprocess.run(["import", "-window", "root", "PNG24:" + path], check=True)
     image = matplotlib.image.imread(path)[..., :3]
     return image[VIEW]
+
+
+def screenshot_once(path, drawn, timeout):
+    """A screenshot as soon as `drawn` holds for it (or the last one at the timeout): rviz takes its
+    time to start and to redraw, more on a loaded machine, and a test must not guess how long."""
+    deadline = time.time() + timeout
+    region = screenshot(path)
+    while not drawn(region) and time.time() < deadline:
+        time.sleep(0.5)
+        region = screenshot(path)
+    return region
 
 
 def ink(region):
@@ -43,6 +55,16 @@ def ink(region):
 def stuck_blue(region):
     r, g, b = region[..., 0], region[..., 1], region[..., 2]
     return (b > 0.85) & (r < 0.3) & (g < 0.5)
+
+
+def band_rows(region):
+    """The rows of a view that the stuck interface band crosses: more than 50 blue pixels wide."""
+    return numpy.flatnonzero(stuck_blue(region).sum(axis=1) > 50)
+
+
+def band_of(region, rows):
+    """The interface band's rows (one row of margin) of a view; nothing if no band was found."""
+    return region[max(rows.min() - 1, 0):rows.max() + 2] if rows.size else region[:0]
 
 
 def sliding_nodes(frame):
@@ -66,8 +88,13 @@ class RvizScreenshot(unittest.TestCase):
         cls.sliding_frame = None
         rospy.wait_for_service("/rig/pause", timeout=60)
         cls.pause = rospy.ServiceProxy("/rig/pause", SetBool, persistent=True)
-        time.sleep(12.0)  # rviz starts, loads the plugins, draws the loading slider
-        cls.stuck = screenshot(os.path.join(cls.out, "stuck.png"))
+        # rviz starts, loads the plugins and draws the loading slider with its interface band.
+        cls.stuck = screenshot_once(os.path.join(cls.out, "stuck.png"),
+                                    lambda view: ink(view).sum() > 20000 and band_rows(view).size > 0, 120)
+        cls.band_rows = band_rows(cls.stuck)
+        # Within the band's rows only: the colour bar beside the slider is blue at its bottom too.
+        columns = numpy.flatnonzero(stuck_blue(cls.stuck)[cls.band_rows].any(axis=0))
+        cls.band_columns = (columns.min(), columns.max()) if columns.size else (0, 0)
         # Pause the rig from the frame callback itself, while the event is still under way. On a loaded
         # machine the pause can land after the event has ended (the simulator catches up on its pace):
         # then the last frame, the one the display shows, is stuck again, and the rig runs on to the next.
@@ -82,13 +109,8 @@ class RvizScreenshot(unittest.TestCase):
                 cls.sliding_frame = None
                 cls.pause(False)
             time.sleep(0.01)
-        time.sleep(3.0)
-        cls.sliding = screenshot(os.path.join(cls.out, "sliding.png"))
-        blue = stuck_blue(cls.stuck)
-        cls.band_rows = numpy.flatnonzero(blue.sum(axis=1) > 50)
-        # Within the band's rows only: the colour bar beside the slider is blue at its bottom too.
-        columns = numpy.flatnonzero(blue[cls.band_rows].any(axis=0))
-        cls.band_columns = (columns.min(), columns.max()) if columns.size else (0, 0)
+        cls.sliding = screenshot_once(os.path.join(cls.out, "sliding.png"),
+                                      lambda view: sliding_red(band_of(view, cls.band_rows)).sum() > 100, 60)
         cls.pause(False)
         cls.rviz.terminate()
         cls.rviz.wait(timeout=30)
@@ -109,8 +131,7 @@ class RvizScreenshot(unittest.TestCase):
         self.assertEqual(bad, [], "rviz printed:\n" + "\n".join(bad))
 
     def band(self, region):
-        """The interface band's rows (one row of margin) of a screenshot's view."""
-        return region[max(self.band_rows.min() - 1, 0):self.band_rows.max() + 2]
+        return band_of(region, self.band_rows)
 
     def test_slider_is_drawn_in_the_view(self):
         self.assertGreater(int(ink(self.stuck).sum()), 20000)

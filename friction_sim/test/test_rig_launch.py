@@ -6,7 +6,7 @@ master on a free port."""
 import os
 import signal
 import subprocess
-import time
+import threading
 import unittest
 
 import rosunit
@@ -47,27 +47,37 @@ def descendant_named(root, name):
 
 
 class SlowRun:
-    """The default experiment at a hundredth of real time, with its simulator's pid once it runs."""
+    """The default experiment at a hundredth of real time, with its simulator's pid once its run is under
+    way: once the controller has said that its protocol started."""
+
+    STARTED = "stage controller: protocol started"
 
     def __enter__(self):
         self.process = subprocess.Popen([RIG_LAUNCH, RIG, "real_time_factor:=0.01"], stdout=subprocess.PIPE,
                                         stderr=subprocess.STDOUT, text=True)
-        deadline = time.time() + 60
-        self.simulator = None
-        while self.simulator is None and time.time() < deadline:
-            time.sleep(0.2)
-            self.simulator = descendant_named(self.process.pid, "rig_simulator")
-        time.sleep(2.0)  # past the controller's start delay: the run is under way
+        self.lines = []
+        self.started = threading.Event()
+        self.reader = threading.Thread(target=self.read, daemon=True)
+        self.reader.start()
+        self.started.wait(timeout=60)
+        self.simulator = descendant_named(self.process.pid, "rig_simulator") if self.started.is_set() else None
         return self
 
+    def read(self):
+        for line in self.process.stdout:
+            self.lines.append(line)
+            if self.STARTED in line:
+                self.started.set()
+
     def finish(self):
-        output, _ = self.process.communicate(timeout=120)
-        return self.process.returncode, output
+        self.process.wait(timeout=120)
+        self.reader.join(timeout=10)
+        return self.process.returncode, "".join(self.lines)
 
     def __exit__(self, *exc):
         if self.process.poll() is None:
             self.process.kill()
-            self.process.communicate()
+            self.process.wait()
 
 
 def launch(*args):
