@@ -1,0 +1,91 @@
+#!/usr/bin/python3
+"""rig_report reads the rig's topics by name: a bag of `rosbag record -a` holds the slip events of the
+simulator and of the precursor detector, and each event is tabled once, from the source asked for; a
+bag without the rig's load cells is refused with the topics it does hold."""
+import csv
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+import rosbag
+import rospy
+import rosunit
+from friction_msgs.msg import InterfaceState, SlipEvent
+from geometry_msgs.msg import WrenchStamped
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+RIG_REPORT = os.path.join(ROOT, "friction_sim/scripts/rig_report")
+F_Z = 1920.0
+
+
+def event(index, onset, shear_ratio, rupture_length):
+    msg = SlipEvent()
+    msg.header.stamp = rospy.Time.from_sec(onset + 0.001)
+    msg.index, msg.onset_time, msg.end_time = index, onset, onset + 0.001
+    msg.onset_shear_force, msg.onset_normal_force = shear_ratio * F_Z, F_Z
+    msg.rupture_length, msg.slider_length = rupture_length, 0.14
+    msg.global_event = rupture_length == 0.14
+    return msg
+
+
+def write_bag(path):
+    """Load cells and frames for 0.1 s, two events from the simulator and the same two, with the
+    detector's slightly later reading of F_X, from the detector."""
+    with rosbag.Bag(path, "w") as bag:
+        for step in range(1, 101):
+            stamp = rospy.Time.from_sec(step * 1e-3)
+            wrench = WrenchStamped()
+            wrench.header.stamp = stamp
+            wrench.wrench.force.x, wrench.wrench.force.z = 4.0 * step, -F_Z
+            bag.write("/rig/load_cells", wrench, stamp)
+            frame = InterfaceState()
+            frame.header.stamp = stamp
+            frame.position = [0.0, 0.07, 0.14]
+            frame.slip_velocity = [0.0, 0.0, 0.0]
+            frame.state = [0, 0, 0]
+            bag.write("/rig/interface", frame, stamp)
+        for source, later in [("/rig/slip_events", 0.0), ("/rig/precursor_detector/slip_events", 1e-4)]:
+            for msg in [event(0, 0.03, 0.1 + later, 0.05), event(1, 0.08, 0.2 + later, 0.14)]:
+                bag.write(source, msg, msg.header.stamp)
+
+
+class RigReportTest(unittest.TestCase):
+    def setUp(self):
+        self.work = tempfile.mkdtemp(prefix="rig_report_test_")
+        self.addCleanup(shutil.rmtree, self.work)
+        self.bag = os.path.join(self.work, "run.bag")
+        write_bag(self.bag)
+
+    def report(self, *args):
+        return subprocess.run(["/usr/bin/python3", RIG_REPORT, self.bag, "--out", self.work] + list(args),
+                              capture_output=True, text=True, timeout=120)
+
+    def table(self):
+        with open(os.path.join(self.work, "events.csv")) as handle:
+            return list(csv.DictReader(handle))
+
+    def test_each_event_is_tabled_once_from_the_simulator_by_default(self):
+        done = self.report()
+        self.assertEqual(done.returncode, 0, done.stderr)
+        rows = self.table()
+        self.assertEqual([row["shear_ratio"] for row in rows], ["0.10000", "0.20000"])
+        self.assertEqual([row["global"] for row in rows], ["0", "1"])
+        for figure in ["loading_curve.png", "precursors.png", "slip_map.png"]:
+            self.assertTrue(os.path.exists(os.path.join(self.work, figure)), figure)
+
+    def test_the_detectors_events_on_request(self):
+        done = self.report("--events", "detector")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertEqual([row["shear_ratio"] for row in self.table()], ["0.10010", "0.20010"])
+
+    def test_a_bag_without_the_rigs_load_cells_is_refused_naming_its_topics(self):
+        done = self.report("--ns", "bench")
+        self.assertNotEqual(done.returncode, 0)
+        self.assertIn("holds no /bench/load_cells; its topics:", done.stderr)
+        self.assertIn("/rig/load_cells", done.stderr)
+
+
+if __name__ == "__main__":
+    rosunit.unitrun("friction_sim", "rig_report", RigReportTest)
