@@ -18,13 +18,22 @@ export ROSCONSOLE_STDOUT_LINE_BUFFERED="${ROSCONSOLE_STDOUT_LINE_BUFFERED:-1}"
 echo "rig_launch: private master at $ROS_MASTER_URI; to reach it from another shell:"
 echo "  source $RIG_WS/devel/setup.bash; export ROS_MASTER_URI=$ROS_MASTER_URI ROS_IP=127.0.0.1"
 
+# roslaunch runs its nodes in $ROS_HOME: a relative scene, protocol or bag path on the command line is
+# taken from the directory the user is in, as they would expect, not from there.
+relative_path_argument='^(scene|protocol|bag):=([^/$].*)$'
+arguments=()
+for argument in "$@"; do
+  [[ "$argument" =~ $relative_path_argument ]] && argument="${BASH_REMATCH[1]}:=$PWD/${BASH_REMATCH[2]}"
+  arguments+=("$argument")
+done
+
 launched_after=$(mktemp)
 trap 'rm -f "$launched_after"' EXIT
 # roslaunch runs as a job of its own, so that this script can read its log when it ends and pass on a
 # signal meanwhile; job control keeps it from starting with SIGINT ignored, as a script's background
 # jobs otherwise do. Every signal is passed on as SIGINT, on which roslaunch stops its nodes cleanly.
 set -m
-roslaunch --port "$port" "$@" &
+roslaunch --port "$port" "${arguments[@]}" &
 launch_pid=$!
 interrupted=0
 trap 'interrupted=1; kill -INT "$launch_pid" 2>/dev/null || true' INT TERM HUP

@@ -29,7 +29,9 @@ xvfb-run -a -s "-screen 0 1400x900x24" bash -c '
   done
   sleep 3  # rviz draws the last messages
   grep -qE "player-[0-9]+\] process has finished" "$WORK/launch.log" && import -window root "$WORK/rviz.png"
-  kill -INT "$launch" 2>/dev/null
+  # TERM, not INT: a background job of a non-interactive shell starts with SIGINT ignored, which no
+  # trap can undo, and the launch (required:=false) would run on with rviz.
+  kill -TERM "$launch" 2>/dev/null
   wait "$launch" || true'
 if [ ! -s "$work/rviz.png" ]; then
   tail -n 20 "$work/launch.log" >&2
@@ -37,4 +39,5 @@ if [ ! -s "$work/rviz.png" ]; then
   exit 1
 fi
 mv "$work/rviz.png" "$out"
+rm -rf "$work"
 echo "rviz_figure: wrote $out"

@@ -4,8 +4,10 @@ crashes, so the script reads the nodes' exit codes and fails, naming the node; a
 exits 0, an interrupted one 130 after every node has stopped. Each launch brings up its own private
 master on a free port."""
 import os
+import shutil
 import signal
 import subprocess
+import tempfile
 import threading
 import unittest
 
@@ -80,8 +82,8 @@ class SlowRun:
             self.process.wait()
 
 
-def launch(*args):
-    done = subprocess.run([RIG_LAUNCH, RIG] + list(args), capture_output=True, text=True, timeout=120)
+def launch(*args, cwd=None):
+    done = subprocess.run([RIG_LAUNCH, RIG] + list(args), capture_output=True, text=True, timeout=120, cwd=cwd)
     return done.returncode, done.stdout + done.stderr
 
 
@@ -128,10 +130,15 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertIn("interrupted by a signal", output)
         self.assertFalse(os.path.exists("/proc/%d" % run.simulator), "the simulator outlived the launch")
 
-    def test_a_run_that_reaches_its_stop_condition_succeeds(self):
-        # The single block slips at µ_s·F_Z = 0.4 × 1920 N three times and stops (its scene's stop).
-        status, output = launch("scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false")
+    def test_a_run_that_reaches_its_stop_condition_succeeds_with_paths_relative_to_the_users_directory(self):
+        # The single block slips at µ_s·F_Z = 0.4 × 1920 N three times and stops (its scene's stop). The
+        # nodes run elsewhere ($ROS_HOME): the scene and the bag are where the user's relative paths say.
+        work = tempfile.mkdtemp(prefix="rig_launch_test_")
+        self.addCleanup(shutil.rmtree, work)
+        status, output = launch("scene:=" + os.path.relpath(SINGLE_BLOCK, work), "record:=true", "bag:=run.bag",
+                                "controller:=false", "analysis:=false", cwd=work)
         self.assertEqual(status, 0, output)
+        self.assertTrue(os.path.exists(os.path.join(work, "run.bag")), output)
         self.assertIn("reached 3 global slip event(s)", output)
         self.assertRegex(output, r"mu_s,macro = F_X/F_Z at the first global event: 0\.4\n")
         self.assertNotIn("rig_launch: failed", output)
