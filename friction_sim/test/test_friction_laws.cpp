@@ -192,8 +192,10 @@ TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
 
 /// The same node under linear slip weakening over ξ_µ = 0.1 µm.
 class OneWeakeningNode : public OneNode {
- protected:
+ public:
   static constexpr double kWeakeningLength = 1e-7;
+
+ protected:
   OneWeakeningNode() : OneNode(std::make_unique<LinearSlipWeakening>(kMuS, kMuK, kWeakeningLength)) {}
 };
 
@@ -216,6 +218,65 @@ TEST_F(OneWeakeningNode, TheCatchUpSlipWeakensFriction) {
   EXPECT_DOUBLE_EQ(net(5.0, 10.0),
                    5.0 - (kMuS - (kMuS - kMuK) * (catch_up + step_slip) / kWeakeningLength) * 10.0);
 }
+
+/// µ(δ) = µ_s − (µ_s − µ_k)·min(δ/ξ_µ, 1) (MODEL.md §4).
+double weakened(double slip) { return kMuS - (kMuS - kMuK) * std::min(slip / OneWeakeningNode::kWeakeningLength, 1.0); }
+
+class OneWeakeningNodeBothWays : public OneWeakeningNode, public ::testing::WithParamInterface<double> {
+ protected:
+  /// Moves the sliding node by `slip` (m) over one step, its velocity keeping the sign of `slip`.
+  void slide(double slip) {
+    contact_.beginStep(u_, v_);
+    u_[0] += slip;
+    v_[0] = slip > 0.0 ? 1e-3 : -1e-3;
+    contact_.finishStep(u_, v_, 1e-3);
+  }
+};
+
+TEST_P(OneWeakeningNodeBothWays, StaysStuckUpToStaticFrictionThenWeakensOverTheSlipFromMuSToMuK) {
+  const double sign = GetParam(), xi = kWeakeningLength;
+  EXPECT_FALSE(update(sign * 4.0, 10.0));  // µ_s·N holds
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -sign * 4.0);
+  EXPECT_TRUE(update(sign * 4.1, 10.0));   // beyond it: slides, unweakened at first
+  EXPECT_DOUBLE_EQ(net(sign * 4.1, 10.0), sign * (4.1 - kMuS * 10.0));
+  slide(sign * 0.25 * xi);  // the step right after unsticking: weakens, cannot re-stick
+  EXPECT_DOUBLE_EQ(net(sign * 4.1, 10.0), sign * (4.1 - weakened(0.25 * xi) * 10.0));
+  slide(sign * 0.5 * xi);  // δ is the slip summed, 0.75 ξ_µ
+  EXPECT_NEAR(net(sign * 4.1, 10.0), sign * (4.1 - weakened(0.75 * xi) * 10.0), 1e-12);
+  EXPECT_NEAR(contact_.frictionForce(0), -sign * weakened(0.75 * xi) * 10.0, 1e-12);
+  slide(sign * xi);  // beyond ξ_µ: µ_k, and no lower
+  EXPECT_DOUBLE_EQ(net(sign * 4.1, 10.0), sign * (4.1 - kMuK * 10.0));
+}
+
+TEST_P(OneWeakeningNodeBothWays, ReStickingRestoresStaticFriction) {
+  const double sign = GetParam();
+  update(sign * 4.1, 10.0);
+  slide(sign * 2.0 * kWeakeningLength);
+  ASSERT_DOUBLE_EQ(net(sign * 4.1, 10.0), sign * (4.1 - kMuK * 10.0));
+  // Its velocity passes through zero within a step: it re-sticks, and δ starts again from 0.
+  contact_.beginStep(u_, v_);
+  v_[0] = -sign * 1e-3;
+  ASSERT_TRUE(contact_.finishStep(u_, v_, 1e-3));
+  ASSERT_EQ(contact_.state(0), ContactState::Stuck);
+  EXPECT_FALSE(update(sign * 4.0, 10.0));  // held again up to µ_s·N
+  EXPECT_TRUE(update(sign * 4.1, 10.0));
+  EXPECT_DOUBLE_EQ(net(sign * 4.1, 10.0), sign * (4.1 - kMuS * 10.0));
+}
+
+TEST_P(OneWeakeningNodeBothWays, HasNoFrictionWithoutContactAndLandsSlidingOnAFreshContact) {
+  const double sign = GetParam();
+  update(sign * 4.1, 10.0);
+  slide(sign * 2.0 * kWeakeningLength);
+  ASSERT_TRUE(update(sign * 1.0, 0.0));  // lifts off while weakened
+  EXPECT_EQ(contact_.state(0), ContactState::Detached);
+  EXPECT_DOUBLE_EQ(net(sign * 1.0, 0.0), sign * 1.0);
+  // It lands moving: a new contact, unstuck at this update (δ = 0), so µ_s opposes the motion.
+  ASSERT_TRUE(update(sign * 1.0, 10.0));
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  EXPECT_DOUBLE_EQ(net(sign * 1.0, 10.0), sign * (1.0 - kMuS * 10.0));
+}
+
+INSTANTIATE_TEST_SUITE_P(ForwardsAndBackwards, OneWeakeningNodeBothWays, ::testing::Values(1.0, -1.0));
 
 TEST_F(OneNode, CrossingIsInterpolatedFromTheLoadAtTheLastUpdateUnderItsOwnNormalForce) {
   update(3.0, 8.0);  // load ratio 3/(µ_s·8)

@@ -45,6 +45,7 @@ class AmontonsCoulomb : public FrictionLaw {
 };
 
 /// Linear slip weakening: µ(δ) = µ_s − (µ_s − µ_k)·min(δ/ξ_µ, 1), δ = slip since the node last unstuck.
+/// Landing sliding after a loss of contact counts as unsticking: the new contact starts unweakened.
 class LinearSlipWeakening : public FrictionLaw {
  public:
   LinearSlipWeakening(double static_coefficient, double kinetic_coefficient, double weakening_length);
