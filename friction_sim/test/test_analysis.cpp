@@ -240,6 +240,22 @@ TEST(FrameEventDetector, FindsTheSimulatorsEventsFromTheInstrumentsAlone) {
   }
 }
 
+TEST(FrameEventDetector, TheSingleBlocksSlipsSpanTheSliderAsTheSimulatorsDo) {
+  // One interface node has no span: given the scene's L, its global slips have L_p = L, as the
+  // simulator's events have.
+  Simulation simulation(loadScene(testing::scenePath("single_block")));
+  const Scene& scene = simulation.scene();
+  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal,
+                              scene.geometry.length);
+  const std::vector<SlipEvent> found = eventsSeenByTheInstruments(simulation, detector);
+  ASSERT_EQ(found.size(), 3u);
+  expectTheSameEventsAndExtents(found, simulation.events());
+  for (const SlipEvent& event : found) {
+    EXPECT_TRUE(event.global);
+    EXPECT_EQ(event.rupture_length, scene.geometry.length);
+  }
+}
+
 TEST(FrameEventDetector, StuckNodesMovingOnTheirInterfacialSpringsDidNotSlip) {
   // With k_T every stuck node moves a little as the load changes; only the nodes seen sliding slipped.
   Scene scene = loadScene(testing::scenePath("pmma_1d_side"));

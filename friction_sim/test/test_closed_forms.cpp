@@ -48,6 +48,7 @@ TEST_P(SingleBlockStickSlip, MatchesTheClosedFormCycle) {
     const SlipEvent& event = events[e];
     SCOPED_TRACE("event " + std::to_string(e));
     EXPECT_TRUE(event.global);
+    EXPECT_EQ(event.rupture_length, scene.geometry.length);  // the block is the whole slider
     EXPECT_NEAR(direction * event.onset_shear_force, mu_s * normal, 1e-6 * mu_s * normal);
     EXPECT_NEAR(event.end_time - event.onset_time, slip_time, 1e-6 * slip_time);
     EXPECT_NEAR(direction * (event.onset_shear_force - event.end_shear_force), 2.0 * (mu_s - mu_k) * normal,

@@ -19,8 +19,8 @@ namespace friction {
 class FrameEventDetector {
  public:
   /// `front_fit_nodes` as in the scene; `longitudinal_speed` (m/s, c_L; ≤ 0 unknown) for the events'
-  /// median front speed (summarizeFrontSpeeds).
-  FrameEventDetector(int front_fit_nodes, double longitudinal_speed);
+  /// median front speed (summarizeFrontSpeeds); `slider_length` (m, L; 0 unknown: the frames' span).
+  FrameEventDetector(int front_fit_nodes, double longitudinal_speed, double slider_length = 0.0);
 
   /// Load-cell samples, in time order.
   void addLoadCells(const LoadCellReading& reading);
@@ -32,14 +32,15 @@ class FrameEventDetector {
   /// Forgets everything (time jumped backwards, e.g. looped playback).
   void reset();
 
-  /// m, the slider's length L as the frames show it (the last interface node sits at x = L); 0 before
-  /// the first frame.
-  double sliderLength() const { return slider_length_; }
+  /// m, the slider's length L: as given, or as the frames show it (the last interface node sits at
+  /// x = L; 0 before the first frame, and for a single block).
+  double sliderLength() const { return given_length_ > 0.0 ? given_length_ : frames_length_; }
 
  private:
   int front_fit_nodes_;
   double longitudinal_speed_;
-  double slider_length_ = 0.0;
+  double given_length_;         ///< m, L from the run's scene; 0 unknown
+  double frames_length_ = 0.0;  ///< m, the last interface node's x in the frames
   double last_frame_time_ = -std::numeric_limits<double>::infinity();
   int next_index_ = 0;
   std::deque<LoadCellReading> load_cells_;

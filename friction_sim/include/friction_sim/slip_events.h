@@ -41,7 +41,8 @@ struct SlipEvent {
 class SlipEventDetector {
  public:
   /// `longitudinal_speed` (m/s, c_L) for the events' median front speed (summarizeFrontSpeeds).
-  SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed);
+  /// `slider_length` (m): L, the single block's L_p when it slips (measureExtent).
+  SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed, double slider_length);
 
   /// The load cells over the step just taken: F_X at its start and end, F_Z.
   struct StepLoads {
@@ -64,6 +65,7 @@ class SlipEventDetector {
   std::vector<int> dofs_;
   int fit_nodes_;
   double longitudinal_speed_;
+  double slider_length_;  ///< m, L
   bool in_event_ = false;
   SlipEvent current_;
   double shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the current event so far
@@ -121,5 +123,10 @@ FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
 /// Sets an ended event's front_speed (frontSpeeds, from its first_unstick_time at the nodes' `positions`,
 /// m), median_front_speed and front_fits_left_out (summarizeFrontSpeeds).
 void measureFronts(SlipEvent& event, const std::vector<double>& positions, int fit_nodes, double longitudinal_speed);
+
+/// Sets slip_min_x, slip_max_x, rupture_length and global from the nodes that slipped (those with a
+/// first-unstick time) at `positions` (m). L_p spans them; a one-node interface, the single block, is the
+/// whole slider: L_p = `slider_length` (m) once it slips.
+void measureExtent(SlipEvent& event, const std::vector<double>& positions, double slider_length);
 
 }  // namespace friction

@@ -13,8 +13,8 @@ bool anySliding(const InterfaceFrame& frame) {
 }
 }  // namespace
 
-FrameEventDetector::FrameEventDetector(int front_fit_nodes, double longitudinal_speed)
-    : front_fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed) {}
+FrameEventDetector::FrameEventDetector(int front_fit_nodes, double longitudinal_speed, double slider_length)
+    : front_fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed), given_length_(slider_length) {}
 
 void FrameEventDetector::reset() {
   next_index_ = 0;
@@ -71,7 +71,7 @@ std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents() {
 void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   const std::size_t n = frame.position.size();
   last_frame_time_ = frame.time;
-  if (n > 0) slider_length_ = frame.position.back();
+  if (n > 0) frames_length_ = frame.position.back();
   const bool sliding = anySliding(frame);
   if (!in_event_) {
     if (!sliding || !last_stuck_frame_ || last_stuck_frame_->position.size() != n) {
@@ -104,21 +104,10 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   SlipEvent event = std::move(current_);
   event.end_time = frame.time;
   event.node_slip.resize(n);
-  double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
-  std::size_t slipped = 0;
-  for (std::size_t node = 0; node < n; ++node) {
-    event.node_slip[node] = frame.slip[node] - last_stuck_frame_->slip[node];
-    // Seen sliding, not merely moved: with an interfacial stiffness stuck nodes move elastically, and
-    // detached nodes move freely.
-    if (std::isnan(event.first_unstick_time[node])) continue;
-    ++slipped;
-    x_min = std::min(x_min, frame.position[node]);
-    x_max = std::max(x_max, frame.position[node]);
-  }
-  event.slip_min_x = x_min;
-  event.slip_max_x = x_max;
-  event.rupture_length = slipped ? x_max - x_min : 0.0;
-  event.global = slipped == n;
+  for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = frame.slip[node] - last_stuck_frame_->slip[node];
+  // The slipped nodes are those seen sliding, not merely moved: with an interfacial stiffness stuck
+  // nodes move elastically, and detached nodes move freely.
+  measureExtent(event, frame.position, sliderLength());
   measureFronts(event, frame.position, front_fit_nodes_, longitudinal_speed_);
   last_stuck_frame_ = frame;
   ended_.push_back(std::move(event));

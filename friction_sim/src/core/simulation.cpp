@@ -20,7 +20,7 @@ Simulation::Simulation(const Scene& scene, double stability_limit)
       contact_(buildFrictionLaw(scene_.friction), *model_, scene_.friction.interfacial_stiffness),
       integrator_(buildIntegrator(scene_.integrator.scheme)),
       stage_(scene_.stage, scene_.integrator.time_step),
-      detector_(*model_, scene_.instruments.front_fit_nodes, waveSpeeds(scene_).longitudinal),
+      detector_(*model_, scene_.instruments.front_fit_nodes, waveSpeeds(scene_).longitudinal, scene_.geometry.length),
       dt_(scene_.integrator.time_step),
       stability_limit_(stability_limit),
       node_mass_(model_->nodeMass()),

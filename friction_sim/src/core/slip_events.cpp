@@ -10,8 +10,9 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
-SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed)
-    : fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed) {
+SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed,
+                                     double slider_length)
+    : fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed), slider_length_(slider_length) {
   for (int node = 0; node < model.interfaceNodeCount(); ++node) {
     positions_.push_back(model.interfacePosition(node));
     dofs_.push_back(model.interfaceDof(node));
@@ -76,20 +77,8 @@ void SlipEventDetector::finish(double end_time, const Vector& u, double end_shea
   event.mean_normal_force = duration > 0.0 ? normal_impulse_ / duration : event.onset_normal_force;
   const std::size_t n = positions_.size();
   event.node_slip.resize(n);
-  double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
-  std::size_t slipped = 0;
-  for (std::size_t node = 0; node < n; ++node) {
-    event.node_slip[node] = u[dofs_[node]] - onset_u_[node];
-    if (!std::isnan(event.first_unstick_time[node])) {
-      ++slipped;
-      x_min = std::min(x_min, positions_[node]);
-      x_max = std::max(x_max, positions_[node]);
-    }
-  }
-  event.slip_min_x = x_min;
-  event.slip_max_x = x_max;
-  event.rupture_length = x_max - x_min;
-  event.global = slipped == n;
+  for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = u[dofs_[node]] - onset_u_[node];
+  measureExtent(event, positions_, slider_length_);
   measureFronts(event, positions_, fit_nodes_, longitudinal_speed_);
   if (event.global) ++global_count_;
   events_.push_back(std::move(event));
@@ -190,6 +179,27 @@ FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
   const std::size_t middle = running.size() / 2;
   summary.median = running.size() % 2 ? running[middle] : 0.5 * (running[middle - 1] + running[middle]);
   return summary;
+}
+
+void measureExtent(SlipEvent& event, const std::vector<double>& positions, double slider_length) {
+  double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
+  std::size_t slipped = 0;
+  for (std::size_t node = 0; node < positions.size(); ++node) {
+    if (std::isnan(event.first_unstick_time[node])) continue;
+    ++slipped;
+    x_min = std::min(x_min, positions[node]);
+    x_max = std::max(x_max, positions[node]);
+  }
+  event.slip_min_x = x_min;
+  event.slip_max_x = x_max;
+  event.global = slipped == positions.size();
+  if (slipped == 0) {
+    event.rupture_length = 0.0;
+  } else if (positions.size() == 1) {
+    event.rupture_length = slider_length;
+  } else {
+    event.rupture_length = x_max - x_min;
+  }
 }
 
 void measureFronts(SlipEvent& event, const std::vector<double>& positions, int fit_nodes, double longitudinal_speed) {

@@ -45,8 +45,8 @@ PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private
     : nh_(std::move(nh)), private_nh_(std::move(private_nh)) {
   const DetectorSettings settings = resolveDetectorSettings(options);
   wave_speeds_ = settings.wave_speeds;
-  slider_length_ = settings.slider_length;
-  detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, wave_speeds_.longitudinal);
+  detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, wave_speeds_.longitudinal,
+                                                   settings.slider_length);
   events_pub_ = private_nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   points_pub_ = private_nh_.advertise<friction_msgs::PrecursorPoint>("precursor_points", 1000, true);
   // Deep queues: a bag played fast must not drop frames, or events would be merged.
@@ -79,7 +79,7 @@ void PrecursorDetector::onFrame(const friction_msgs::InterfaceState::ConstPtr& m
 
 void PrecursorDetector::publishCompleted() {
   for (const SlipEvent& event : detector_->takeCompletedEvents()) {
-    const double length = slider_length_ > 0.0 ? slider_length_ : detector_->sliderLength();
+    const double length = detector_->sliderLength();
     events_pub_.publish(toMsg(event, positions_, length, wave_speeds_, frame_id_));
     points_pub_.publish(toPointMsg(event, length, frame_id_));
     ROS_INFO_STREAM("precursor detector: event " << event.index << " F_X/F_Z = "

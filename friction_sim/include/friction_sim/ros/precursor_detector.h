@@ -69,7 +69,6 @@ class PrecursorDetector {
   ros::NodeHandle nh_, private_nh_;
   std::unique_ptr<FrameEventDetector> detector_;
   WaveSpeeds wave_speeds_;
-  double slider_length_ = 0.0;  ///< m, the scene's L, or 0: the span of the interface nodes
   std::vector<double> positions_;
   std::string frame_id_;  ///< the interface frames', for the events
   ros::Time last_stamp_;
