@@ -46,7 +46,8 @@ TEST(LoadingProtocol, BadProtocolListsEveryProblem) {
         "steps:\n"
         "  - {action: normal_load, normal_force: -5}\n"
         "  - {action: drive, speed: .nan, duration: .inf}\n"
-        "  - {action: jump}\n"
+        "  - {action: jump}\n"  // refused alone: its other keys are not checked against a guessed action
+        "  - {action: hold, duration: 1.0}\n"
         "end: {global_events: -1, cycles: 3}\n");
     FAIL() << "accepted";
   } catch (const ConfigError& error) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/scene_io.h"
@@ -91,6 +93,9 @@ INSTANTIATE_TEST_SUITE_P(
         // Holds while the stage pushes; the trailing-edge-heavy tilt lifts the leading block once it pulls.
         InvalidCase{"model: chain_1d\nchain: {tilt: -0.8, torque_share: 1.0}\npusher: {height: 0.03}",
                     "at F_X = -768 N", "F_X in [-768, 768] N, the stage pushing or pulling"},
+        // µ_k = 0.17 is not blamed for a refused µ_s.
+        InvalidCase{"friction: {static_coefficient: -0.4}", "friction.static_coefficient: value -0.4",
+                    "a finite number >= 0"},
         InvalidCase{"frictoin: {law: amontons_coulomb}", "frictoin: unknown key", "allowed keys here"},
         InvalidCase{"friction: {mu_s: 0.4}", "friction.mu_s: unknown key", "static_coefficient"},
         InvalidCase{"friction: {law: coulomb}", "friction.law: value 'coulomb'", "amontons_coulomb | slip_weakening"},
@@ -117,6 +122,19 @@ TEST(SceneFiles, AShearProfileWithinTheStaticThresholdsIsHeldAsGiven) {
     EXPECT_EQ(frame.state[i], 0) << "block " << i;
     EXPECT_NEAR(frame.friction_force[i], expected[i], 1e-6) << "block " << i;
   }
+}
+
+TEST(InvalidScene, AYamlSyntaxErrorNamesTheFile) {
+  const std::string path = (std::filesystem::temp_directory_path() / "friction_sim_broken_scene.yaml").string();
+  std::ofstream(path) << "friction: {static_coefficient: 0.4\n";  // the brace is never closed
+  try {
+    loadScene(path);
+    FAIL() << "accepted";
+  } catch (const SceneError& error) {
+    ASSERT_EQ(error.problems().size(), 1u);
+    EXPECT_NE(error.problems()[0].find("YAML syntax error in '" + path + "'"), std::string::npos) << error.what();
+  }
+  std::filesystem::remove(path);
 }
 
 TEST(InvalidScene, UnstableTimeStepMessageGivesTheLimit) {

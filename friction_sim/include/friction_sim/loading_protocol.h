@@ -23,7 +23,9 @@ enum class ProtocolAction { NormalLoad, Hold, Drive, MoveTo };
 struct ProtocolStep {
   ProtocolAction action = ProtocolAction::Drive;
   double normal_force = 0.0;  ///< N, F_Z to reach (normal_load)
-  double ramp_time = 0.0;     ///< s, F_Z changes linearly over this time (normal_load; 0 = at once)
+  /// s, F_Z ramps over this time (normal_load; 0 = at once): a staircase of ramp_commands equal steps,
+  /// the k-th at (k − 1)/n of it, so that F_Z reaches its target at (n − 1)/n·ramp_time.
+  double ramp_time = 0.0;
   double speed = 4.0e-4;      ///< m/s, stage speed (drive, signed) or travel speed (move_to)
   double target = 0.0;        ///< m, stage position (move_to)
   double duration = std::numeric_limits<double>::infinity();  ///< s, how long the step lasts (hold, drive, move_to)
@@ -38,7 +40,7 @@ struct ProtocolEnd {
 struct LoadingProtocol {
   std::vector<ProtocolStep> steps{ProtocolStep{}};
   ProtocolEnd end;
-  int ramp_commands = 20;  ///< F_Z commands per ramp
+  int ramp_commands = 20;  ///< F_Z commands (equal steps) per ramp, n >= 1
 };
 
 /// A command to the rig at a simulated time.
@@ -51,7 +53,7 @@ struct TimedCommand {
 };
 
 /// Throws ConfigError listing every problem.
-LoadingProtocol parseProtocol(const std::string& yaml_text);
+LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& source = "");
 LoadingProtocol loadProtocol(const std::string& path);
 
 /// The protocol's commands from `start_time` (s), ramps starting at F_Z = `start_normal_force` (N);

@@ -27,8 +27,15 @@ class ConfigError : public std::runtime_error {
   std::vector<std::string> problems_;
 };
 
-/// Parses YAML text whose top level must be a mapping; throws ConfigError about `what` otherwise.
-YAML::Node loadMapping(const std::string& text, const std::string& what);
+/// Appends "field: value V is not allowed; allowed: A" to `problems` unless `ok`: the one form of every
+/// refusal of a setting, in files and node parameters alike. V with ten digits; NaN as "nan", whatever
+/// its sign bit.
+void requireSetting(bool ok, const std::string& field, double value, const std::string& allowed,
+                    std::vector<std::string>& problems);
+
+/// Parses YAML text whose top level must be a mapping; throws ConfigError about `what` otherwise. A
+/// syntax error names `source`, the file the text came from ("" for text given directly).
+YAML::Node loadMapping(const std::string& text, const std::string& what, const std::string& source = "");
 
 /// Reads a whole text file; adds a problem if it cannot be read.
 std::string readTextFile(const std::string& path, std::vector<std::string>& problems);

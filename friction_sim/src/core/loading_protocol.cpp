@@ -1,7 +1,7 @@
 #include "friction_sim/loading_protocol.h"
 
+#include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "friction_sim/yaml_fields.h"
 
@@ -15,10 +15,10 @@ const EnumTable<ProtocolAction>& enumTable(ProtocolAction) {
   return names;
 }
 
-LoadingProtocol parseProtocol(const std::string& yaml_text) {
+LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& source) {
   LoadingProtocol protocol;
   std::vector<std::string> problems;
-  const YAML::Node root = loadMapping(yaml_text, "protocol");
+  const YAML::Node root = loadMapping(yaml_text, "protocol", source);
   YamlFieldReader reader(root, problems);
   reader.list("steps", protocol.steps, [&](ProtocolStep& step) {
     reader.field("action", step.action);
@@ -37,13 +37,18 @@ LoadingProtocol parseProtocol(const std::string& yaml_text) {
   reader.rejectUnknownKeys();
 
   auto problem = [&](const std::string& field, double value, const std::string& allowed) {
-    std::ostringstream text;
-    text << field << ": value " << value << " is not allowed; allowed: " << allowed;
-    problems.push_back(text.str());
+    requireSetting(false, field, value, allowed, problems);
   };
   for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
     const ProtocolStep& step = protocol.steps[i];
     const std::string where = "steps[" + std::to_string(i) + "]";
+    // A step whose action was refused has no rules to check its other keys by: they would blame
+    // fields the user never wrote.
+    const std::string refused_action = where + ".action:";
+    if (std::any_of(problems.begin(), problems.end(),
+                    [&](const std::string& p) { return p.compare(0, refused_action.size(), refused_action) == 0; })) {
+      continue;
+    }
     if (step.action == ProtocolAction::NormalLoad) {
       if (!(step.normal_force > 0.0) || !std::isfinite(step.normal_force)) problem(where + ".normal_force", step.normal_force, "a finite F_Z > 0 N");
       if (!(step.ramp_time >= 0.0) || !std::isfinite(step.ramp_time)) problem(where + ".ramp_time", step.ramp_time, "a finite time >= 0 s");
@@ -68,7 +73,7 @@ LoadingProtocol loadProtocol(const std::string& path) {
   std::vector<std::string> problems;
   const std::string text = readTextFile(path, problems);
   if (!problems.empty()) throw ConfigError("protocol", problems);
-  return parseProtocol(text);
+  return parseProtocol(text, path);
 }
 
 std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, double start_time,

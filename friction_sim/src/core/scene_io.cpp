@@ -189,12 +189,27 @@ ConfigError::ConfigError(const std::string& what_was_refused, std::vector<std::s
       }()),
       problems_(std::move(problems)) {}
 
-YAML::Node loadMapping(const std::string& text, const std::string& what) {
+void requireSetting(bool ok, const std::string& field, double value, const std::string& allowed,
+                    std::vector<std::string>& problems) {
+  if (ok) return;
+  std::ostringstream text;
+  text.precision(10);
+  text << field << ": value ";
+  if (std::isnan(value)) {
+    text << "nan";
+  } else {
+    text << value;
+  }
+  text << " is not allowed; allowed: " << allowed;
+  problems.push_back(text.str());
+}
+
+YAML::Node loadMapping(const std::string& text, const std::string& what, const std::string& source) {
   YAML::Node root;
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& error) {
-    throw ConfigError(what, {std::string("YAML syntax error: ") + error.what()});
+    throw ConfigError(what, {"YAML syntax error" + (source.empty() ? "" : " in '" + source + "'") + ": " + error.what()});
   }
   if (!root.IsMap()) throw ConfigError(what, {what + ": expected a mapping at the top level"});
   return root;
@@ -212,12 +227,14 @@ std::string readTextFile(const std::string& path, std::vector<std::string>& prob
 }
 
 namespace {
-/// The fields of `yaml_text` read over `base`; problems are collected, the result is not validated.
-Scene readFields(const std::string& yaml_text, const Scene& base, std::vector<std::string>& problems) {
+/// The fields of `yaml_text` (from the file `source`, "" for none) read over `base`; problems are
+/// collected, the result is not validated.
+Scene readFields(const std::string& yaml_text, const std::string& source, const Scene& base,
+                 std::vector<std::string>& problems) {
   Scene scene = base;
   YAML::Node root;
   try {
-    root = loadMapping(yaml_text, "scene");
+    root = loadMapping(yaml_text, "scene", source);
   } catch (const ConfigError& error) {
     throw SceneError(error.problems());
   }
@@ -264,7 +281,7 @@ std::string overridesYaml(const std::vector<std::pair<std::string, std::string>>
 
 Scene parseScene(const std::string& yaml_text, const Scene& base, double* stability_limit) {
   std::vector<std::string> problems;
-  const Scene scene = readFields(yaml_text, base, problems);
+  const Scene scene = readFields(yaml_text, "", base, problems);
   return validated(scene, problems, stability_limit);
 }
 
@@ -273,9 +290,9 @@ Scene loadScene(const std::string& path, const std::vector<std::pair<std::string
   std::vector<std::string> problems;
   const std::string text = readTextFile(path, problems);
   if (!problems.empty()) throw SceneError(problems);
-  Scene scene = readFields(text, Scene{}, problems);
+  Scene scene = readFields(text, path, Scene{}, problems);
   // Validated once, with the overrides applied: validation estimates a large lattice's spectrum.
-  if (!overrides.empty()) scene = readFields(overridesYaml(overrides), scene, problems);
+  if (!overrides.empty()) scene = readFields(overridesYaml(overrides), "", scene, problems);
   return validated(scene, problems, stability_limit);
 }
 

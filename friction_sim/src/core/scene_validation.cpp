@@ -15,11 +15,7 @@ class Checker {
  public:
   /// Records "field: value V is not allowed; allowed: ..." unless `ok`.
   void require(bool ok, const std::string& field, double value, const std::string& allowed) {
-    if (ok) return;
-    std::ostringstream text;
-    text.precision(10);
-    text << field << ": value " << value << " is not allowed; allowed: " << allowed;
-    problems.push_back(text.str());
+    requireSetting(ok, field, value, allowed, problems);
   }
   void positive(const std::string& field, double value) {
     require(std::isfinite(value) && value > 0.0, field, value, "a finite number > 0");
@@ -93,8 +89,12 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
 
   const double mu_s = s.friction.static_coefficient, mu_k = s.friction.kinetic_coefficient;
   check.nonNegative("friction.static_coefficient", mu_s);
-  check.within("friction.kinetic_coefficient", mu_k, 0.0, std::max(mu_s, 0.0),
-               "0 <= mu_k <= mu_s = friction.static_coefficient");
+  // Against a refused µ_s only its own range: "allowed: [0, 0]" would blame a good µ_k.
+  if (mu_s >= 0.0) {
+    check.within("friction.kinetic_coefficient", mu_k, 0.0, mu_s, "0 <= mu_k <= mu_s = friction.static_coefficient");
+  } else {
+    check.nonNegative("friction.kinetic_coefficient", mu_k);
+  }
   check.nonNegative("friction.weakening_length", s.friction.weakening_length);
   check.nonNegative("friction.interfacial_stiffness", s.friction.interfacial_stiffness);
 

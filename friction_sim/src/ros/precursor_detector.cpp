@@ -3,15 +3,14 @@
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
 #include "friction_sim/scene_io.h"
+#include "friction_sim/yaml_fields.h"
 
 namespace friction {
 
 std::vector<std::string> validateDetectorOptions(const DetectorOptions& options) {
   std::vector<std::string> problems;
-  if (options.front_fit_nodes < 2 && options.front_fit_nodes != 0) {
-    problems.push_back("~front_fit_nodes: value " + std::to_string(options.front_fit_nodes) +
-                       " is not allowed; allowed: >= 2, or 0 for the scene's");
-  }
+  requireSetting(options.front_fit_nodes >= 2 || options.front_fit_nodes == 0, "~front_fit_nodes",
+                 options.front_fit_nodes, ">= 2, or 0 for the scene's", problems);
   if (options.scene_path.empty() && !options.overrides.empty()) {
     problems.push_back("~overrides: '" + options.overrides + "' given without ~scene; allowed: overrides of a scene");
   }

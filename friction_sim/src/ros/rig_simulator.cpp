@@ -31,10 +31,7 @@ bool due(double now, double& next, double rate) {
 std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   std::vector<std::string> problems;
   auto require = [&](bool ok, const std::string& name, double value, const std::string& allowed) {
-    if (ok) return;
-    std::ostringstream text;
-    text << "~" << name << ": value " << value << " is not allowed; allowed: " << allowed;
-    problems.push_back(text.str());
+    requireSetting(ok, "~" + name, value, allowed, problems);
   };
   if (o.scene_path.empty()) problems.push_back("~scene: no value; allowed: the path of a scene YAML file");
   require(std::isfinite(o.real_time_factor) && o.real_time_factor >= 0.0, "real_time_factor", o.real_time_factor,

@@ -7,21 +7,18 @@
 
 #include <cmath>
 #include <cstdint>
-#include <sstream>
 
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
+#include "friction_sim/yaml_fields.h"
 
 namespace friction {
 
 std::vector<std::string> validateControllerOptions(const ControllerOptions& options) {
   std::vector<std::string> problems;
   if (options.protocol_path.empty()) problems.push_back("~protocol: no value; allowed: the path of a protocol YAML file");
-  if (!(std::isfinite(options.start_delay) && options.start_delay >= 0.0)) {
-    std::ostringstream text;
-    text << "~start_delay: value " << options.start_delay << " is not allowed; allowed: >= 0 s";
-    problems.push_back(text.str());
-  }
+  requireSetting(std::isfinite(options.start_delay) && options.start_delay >= 0.0, "~start_delay", options.start_delay,
+                 ">= 0 s", problems);
   return problems;
 }
 
