@@ -39,8 +39,13 @@ RUNNER = os.path.join(ROOT, ".build/devel/lib/friction_sim/friction_run")
 
 
 def load(path):
-    with open(path) as handle:
-        spec = yaml.safe_load(handle)
+    try:
+        with open(path) as handle:
+            spec = yaml.safe_load(handle)
+    except (OSError, yaml.YAMLError) as error:
+        sys.exit("sweep: %s cannot be read: %s" % (path, error))
+    if not isinstance(spec, dict):
+        sys.exit("sweep: %s: expected a mapping with base (required), set, vary, cases" % path)
     unknown = set(spec) - {"base", "set", "vary", "cases"}
     if unknown or "base" not in spec:
         sys.exit("sweep: %s: keys allowed are base (required), set, vary, cases; got %s" % (path, sorted(spec)))
@@ -112,6 +117,16 @@ def first_global(events):
     return next((event for event in events if event["global"] == "1"), None)
 
 
+def failure_reason(log, lines=12):
+    """The end of a failed run's log, where friction_run says why (a refused scene lists its problems)."""
+    try:
+        with open(log) as handle:
+            tail = handle.read().strip().splitlines()[-lines:]
+    except OSError:
+        return "  (no log: the run did not start)"
+    return "\n".join("  " + line for line in tail)
+
+
 def collect(spec, points, out):
     rows, failed = [], []
     for point in points:
@@ -129,7 +144,8 @@ def collect(spec, points, out):
             writer.writeheader()
             writer.writerows(rows)
     for name in failed:
-        print("sweep: run %s failed; see %s" % (name, os.path.join(out, "runs", name, "log.txt")), file=sys.stderr)
+        log = os.path.join(out, "runs", name, "log.txt")
+        print("sweep: run %s failed (%s):\n%s" % (name, log, failure_reason(log)), file=sys.stderr)
     print("sweep: %d of %d runs done, %d events in %s" % (len(points) - len(failed), len(points), len(rows),
                                                            os.path.join(out, "events.csv")))
     return rows, failed
@@ -137,10 +153,11 @@ def collect(spec, points, out):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("sweep")
-    parser.add_argument("--jobs", default=None)
-    parser.add_argument("--hosts", default=None)
-    parser.add_argument("--out", default=None)
+    parser.add_argument("sweep", help="the sweep's YAML file (base, set, vary, cases)")
+    parser.add_argument("--jobs", default=None, help="runs at once on each machine (default: one per core)")
+    parser.add_argument("--hosts", default=None,
+                        help="GNU parallel's --sshlogin list, e.g. '2/node1,2/node2,:' (':' is this machine)")
+    parser.add_argument("--out", default=None, help="results folder (default: sweeps/<sweep file name>)")
     args = parser.parse_args()
     rows, failed = run(args.sweep, args.jobs, args.hosts, args.out)
     sys.exit(1 if failed else 0)

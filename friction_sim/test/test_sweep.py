@@ -4,6 +4,7 @@ every combination runs, a refused run is reported without losing the others, a r
 done, and runs spread over "remote" machines through GNU parallel's --sshlogin (with an ssh stand-in
 that runs the command here, so that no ssh server is needed), with and without a shared file system."""
 import csv
+import io
 import os
 import shutil
 import subprocess
@@ -55,13 +56,21 @@ class SweepTest(unittest.TestCase):
 
     def test_a_refused_run_is_reported_and_the_others_are_kept(self):
         out = os.path.join(self.work, "out")
-        rows, failed = sweep.run(self.write_sweep("[1000, 2000, -5]"), jobs=2, out=out)
+        with mock.patch("sys.stderr", new_callable=io.StringIO) as errors:
+            rows, failed = sweep.run(self.write_sweep("[1000, 2000, -5]"), jobs=2, out=out)
         self.assertEqual(failed, ["normal_force=-5"])
+        # The reason is in the report, not only in the run's log.
+        self.assertIn("load.normal_force: value -5 is not allowed", errors.getvalue())
         self.assert_onsets_follow_amontons(rows, [1000.0, 2000.0])
         with open(os.path.join(out, "events.csv")) as handle:
             self.assertEqual(len(list(csv.DictReader(handle))), 4)
         with open(os.path.join(out, "runs", "normal_force=-5", "log.txt")) as handle:
             self.assertIn("normal_force", handle.read())
+
+    def test_a_sweep_file_that_cannot_be_read_is_named(self):
+        with self.assertRaises(SystemExit) as missing:
+            sweep.run(os.path.join(self.work, "nonexistent.yaml"))
+        self.assertIn("nonexistent.yaml cannot be read", str(missing.exception))
 
     def test_a_rerun_skips_finished_runs_and_retries_failed_ones(self):
         out = os.path.join(self.work, "out")
