@@ -21,7 +21,7 @@ namespace friction {
 enum class ProtocolAction { NormalLoad, Hold, Drive, MoveTo };
 
 struct ProtocolStep {
-  ProtocolAction action = ProtocolAction::Drive;
+  ProtocolAction action = ProtocolAction::Drive;  ///< what the step does: normal_load, hold, drive or move_to
   double normal_force = 0.0;  ///< N, F_Z to reach (normal_load)
   /// s, F_Z ramps over this time (normal_load; 0 = at once): a staircase of ramp_commands equal steps,
   /// the k-th at (k − 1)/n of it, so that F_Z reaches its target at (n − 1)/n·ramp_time.

@@ -56,9 +56,9 @@ struct ChainSpec {
 };
 
 struct FrictionSpec {
-  FrictionLawKind law = FrictionLawKind::AmontonsCoulomb;
-  double static_coefficient = 0.4;    ///< µ_s
-  double kinetic_coefficient = 0.17;  ///< µ_k (≤ µ_s)
+  FrictionLawKind law = FrictionLawKind::AmontonsCoulomb;  ///< the sliding resistance µ (MODEL.md §4)
+  double static_coefficient = 0.4;    ///< µ_s, dimensionless: a stuck node holds up to µ_s·N
+  double kinetic_coefficient = 0.17;  ///< µ_k, dimensionless (≤ µ_s): sliding friction, after weakening
   double weakening_length = 0.0;      ///< m, ξ_µ of linear slip weakening (0 = Amontons–Coulomb)
   /// N/m, k_T: a stuck node is held by this spring to its anchor; 0 = rigid stick constraint
   double interfacial_stiffness = 0.0;
@@ -86,7 +86,7 @@ struct PusherSpec {
 
 /// One segment of the stage program.
 struct StageSegment {
-  StageMode mode = StageMode::Velocity;
+  StageMode mode = StageMode::Velocity;  ///< drive at `speed`, hold still, or travel to `target`
   double speed = 4.0e-4;    ///< m/s, stage speed (velocity mode) or travel speed (position mode)
   double target = 0.0;      ///< m, stage position to reach (position mode)
   double duration = std::numeric_limits<double>::infinity();  ///< s, how long the segment lasts
@@ -98,7 +98,7 @@ struct StageSpec {
 };
 
 struct IntegratorSpec {
-  IntegratorKind scheme = IntegratorKind::VelocityVerlet;
+  IntegratorKind scheme = IntegratorKind::VelocityVerlet;  ///< the explicit time integrator
   double time_step = 2.0e-7;  ///< s, dt; must be below the stability limit computed from the scene
   /// while the whole interface sticks, jump along the static equilibrium to the next threshold
   /// crossing instead of integrating (MODEL.md §5); needs rigid sticking (interfacial_stiffness 0)
@@ -119,8 +119,8 @@ struct StopSpec {
 };
 
 struct Scene {
-  std::string name = "pmma_2d";
-  ModelKind model = ModelKind::Lattice2D;
+  std::string name = "pmma_2d";  ///< names the run's results (results/<name>) and its summary
+  ModelKind model = ModelKind::Lattice2D;  ///< 2D lattice in the x–z plane, or 1D chain of blocks
   GeometrySpec geometry;
   MaterialSpec material;
   LatticeSpec lattice;

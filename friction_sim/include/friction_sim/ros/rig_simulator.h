@@ -83,9 +83,9 @@ struct SimulatorOptions {
   double lattice_rate = 200.0;     ///< Hz, simulated
   double snapshot_rate = 20.0;     ///< Hz, wall
   std::string bag_path;            ///< "" = no bag
-  std::string frame_id = "slider";
-  bool stop_at_scene_end = true;
-  bool start_paused = false;
+  std::string frame_id = "slider";  ///< frame of every message, the slider's (x along the track, z up)
+  bool stop_at_scene_end = true;   ///< end the run when the scene's stop condition holds
+  bool start_paused = false;       ///< wait at t = 0 until `pause` is called with false
 };
 
 /// Every problem of the options, each naming the parameter, the value and the allowed range.
