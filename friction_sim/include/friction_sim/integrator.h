@@ -80,8 +80,8 @@ double stabilityLimit(IntegratorKind kind, double omega_max, double damping_rate
 
 /// ω_max (rad/s) and c_max (1/s) of a model (with the interfacial stiffness k_T on its interface dofs).
 struct ModeBounds {
-  double omega_max = 0.0;
-  double damping_rate = 0.0;
+  double omega_max = 0.0;     ///< rad/s, the highest angular frequency of the undamped model
+  double damping_rate = 0.0;  ///< 1/s, the highest damping rate c of its modes
 };
 ModeBounds modeBounds(const Model& model, double interfacial_stiffness);
 

@@ -38,8 +38,8 @@ struct ProtocolEnd {
 };
 
 struct LoadingProtocol {
-  std::vector<ProtocolStep> steps{ProtocolStep{}};
-  ProtocolEnd end;
+  std::vector<ProtocolStep> steps{ProtocolStep{}};  ///< run in order; the last one persists
+  ProtocolEnd end;  ///< when the protocol, and the run, ends
   int ramp_commands = 20;  ///< F_Z commands (equal steps) per ramp, n >= 1
 };
 
@@ -47,8 +47,8 @@ struct LoadingProtocol {
 struct TimedCommand {
   enum class Kind { Stage, NormalLoad };
   double time = 0.0;  ///< s, simulated
-  Kind kind = Kind::Stage;
-  StageCommand stage;
+  Kind kind = Kind::Stage;  ///< a stage command, or a new F_Z
+  StageCommand stage;       ///< the stage's mode, speed and target (kind Stage)
   double normal_force = 0.0;  ///< N
 };
 

@@ -18,9 +18,9 @@ struct PrecursorPoint {
 };
 
 struct RunSummary {
-  std::string scene_name;
-  std::string stop_reason;
-  int events = 0;
+  std::string scene_name;  ///< the scene's name
+  std::string stop_reason;  ///< which stop condition ended the run, or why it was cut short
+  int events = 0;           ///< slip events that ended
   int precursors = 0;   ///< non-global events before the first global one
   int single_node_precursors = 0;  ///< of those, events in which one node alone slipped (L_p = 0): no front ran
   std::vector<PrecursorPoint> precursor_points;
@@ -28,9 +28,9 @@ struct RunSummary {
   /// µ_k,macro = mean F_X / mean F_Z over the first global event, from onset to end (NaN if none)
   double kinetic_friction_macro = 0.0;
   double simulated_time = 0.0;         ///< s
-  long long steps = 0;
+  long long steps = 0;                 ///< time steps integrated (a fast-forward jump counts as none)
   double wall_time = 0.0;              ///< s
-  double relative_energy_residual = 0.0;
+  double relative_energy_residual = 0.0;  ///< work in − (Δelastic + kinetic + dissipated), over the budget's largest term
   double time_step = 0.0;              ///< s
   double stability_limit = 0.0;        ///< s
 };
