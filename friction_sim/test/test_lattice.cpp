@@ -155,6 +155,19 @@ TEST(LatticeWaves, PAndSWaveSpeedsFromArrivalTimes) {
   EXPECT_NEAR(s_speed, c_s, 0.03 * c_s);
 }
 
+TEST(LatticePusher, PushesTheRowNearestItsHeightOrItsBandAndSaysWhere) {
+  Scene scene;  // pmma_2d: rows 2.5 mm apart
+  scene.pusher.height = 0.006;  // 2.4 spacings: row 2, at 5 mm
+  const Lattice2D single_row(scene);
+  EXPECT_EQ(single_row.pushedRows(), std::vector<int>{2});
+  EXPECT_DOUBLE_EQ(single_row.pushingHeight(), 0.005);
+  scene.pusher.band_min = 0.004;  // rows 2, 3 and 4 (5, 7.5 and 10 mm): the resultant at 7.5 mm
+  scene.pusher.band_max = 0.011;
+  const Lattice2D band(scene);
+  EXPECT_EQ(band.pushedRows(), (std::vector<int>{2, 3, 4}));
+  EXPECT_DOUBLE_EQ(band.pushingHeight(), 0.0075);
+}
+
 TEST(LatticeNodeStiffness, BulkNodeThreeKAndCornerFiveQuarterK) {
   Scene scene = freeLatticeScene(57, 31);
   Lattice2D lattice(scene);

@@ -47,6 +47,7 @@ class Chain1D : public Model {
   Vector initialBodyForce() const override;
   void disconnectPusher() override;
   void connectPusher(const Vector& u) override;
+  double pushingHeight() const override { return pushing_height_; }
   void setNormalLoad(double normal_force) override { normal_force_ = normal_force; }
   GaugeStresses gaugeStresses(const Vector&, double, const std::vector<double>&) const override {
     return {};  // the chain has no vertical dimension: the interface frame is its only stress reading

@@ -53,7 +53,7 @@ struct LatticeSnapshot {
   GaugeStresses stress;                   ///< Pa, per node
   std::vector<std::uint8_t> interface_state;  ///< per interface node, as in InterfaceFrame
   double stage_position = 0.0;            ///< m
-  double pusher_height = 0.0;             ///< m
+  double pusher_height = 0.0;             ///< m, Model::pushingHeight
   double normal_force = 0.0;              ///< N
 };
 

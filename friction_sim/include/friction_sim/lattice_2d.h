@@ -57,6 +57,7 @@ class Lattice2D : public Model {
   std::vector<int> blockedDofsDuringLoading() const override;
   void disconnectPusher() override { pusher_connected_ = false; }
   void connectPusher(const Vector& u) override;
+  double pushingHeight() const override;
   void setNormalLoad(double normal_force) override { normal_force_ = normal_force; }
   /// Not with the spring mattress: its plate is placed once, when F_Z is applied. Moving it by
   /// ΔF_Z/(N_x·k_m) would not do: the slider yields under it, and the springs end up carrying a fraction

@@ -140,6 +140,9 @@ class Model {
   /// unstretched to the current displacements with the stage at position 0.
   virtual void disconnectPusher() = 0;
   virtual void connectPusher(const Vector& u) = 0;
+  /// m, rest height above the interface at which the pusher's resultant acts: the pushed row's (the
+  /// lattice's nearest to the scene's h, or its band's mean), or h where the model places it as given.
+  virtual double pushingHeight() const = 0;
 
   /// N, sets the normal load F_Z.
   virtual void setNormalLoad(double normal_force) = 0;

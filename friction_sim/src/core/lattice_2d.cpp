@@ -435,6 +435,12 @@ std::vector<int> Lattice2D::blockedDofsDuringLoading() const {
   return Model::blockedDofsDuringLoading();
 }
 
+double Lattice2D::pushingHeight() const {
+  double rows = 0.0;
+  for (int row : pushed_rows_) rows += row;
+  return rows / pushed_rows_.size() * spacing_;
+}
+
 void Lattice2D::connectPusher(const Vector& u) {
   pusher_connected_ = true;
   for (std::size_t r = 0; r < pushed_rows_.size(); ++r) {

@@ -543,7 +543,7 @@ LatticeSnapshot Simulation::snapshot() const {
     snapshot.interface_state.push_back(static_cast<std::uint8_t>(contact_.state(node)));
   }
   snapshot.stage_position = stage_.position();
-  snapshot.pusher_height = scene_.pusher.height;
+  snapshot.pusher_height = model_->pushingHeight();
   snapshot.normal_force = evaluation_.normal_load;
   return snapshot;
 }
