@@ -21,6 +21,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <rosgraph_msgs/Clock.h>
+#include <std_msgs/String.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 
@@ -355,6 +356,20 @@ TEST(FullRun, ControllerStartsOverAfterAResetThatCameBeforeTimeMovedOn) {
 TEST(FullRun, BagHoldsEverySlipEventAndEveryInterfaceFrame) {
   ASSERT_GE(g_seen.events.size(), 2u);
   checkBagHasEveryEventAndNoFrameGap(g_seen.events);
+}
+
+TEST(FullRun, BagHoldsTheSceneAsRunFirst) {
+  ASSERT_TRUE(bagReadable(g_bag)) << g_bag;
+  const auto scenes = readTopic<std_msgs::String>(g_bag, "/rig/scene");
+  ASSERT_EQ(scenes.size(), 1u);
+  std::string scene_path;
+  ros::NodeHandle("~").getParam("scene", scene_path);
+  // The recorded text reads back as the scene the launch named, field for field.
+  EXPECT_EQ(sceneToYaml(parseScene(scenes[0]->data)), sceneToYaml(loadScene(scene_path)));
+  rosbag::Bag bag(g_bag);
+  rosbag::View everything(bag);
+  ASSERT_GT(everything.size(), 0u);
+  EXPECT_EQ(everything.begin()->getTopic(), "/rig/scene");
 }
 
 void expectPointsMatchEvents(const std::vector<friction_msgs::PrecursorPoint>& points) {

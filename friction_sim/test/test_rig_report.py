@@ -14,10 +14,12 @@ import rospy
 import rosunit
 from friction_msgs.msg import InterfaceState, SlipEvent
 from geometry_msgs.msg import WrenchStamped
+from std_msgs.msg import String
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 RIG_REPORT = os.path.join(ROOT, "friction_sim/scripts/rig_report")
 F_Z = 1920.0
+SCENE = "name: synthetic\nload: {normal_force: 1920}\n"
 
 
 def event(index, onset, shear_ratio, rupture_length):
@@ -34,6 +36,7 @@ def write_bag(path):
     """Load cells and frames for 0.1 s, two events from the simulator and the same two, with the
     detector's slightly later reading of F_X, from the detector."""
     with rosbag.Bag(path, "w") as bag:
+        bag.write("/rig/scene", String(data=SCENE), rospy.Time(0, 1))
         for step in range(1, 101):
             stamp = rospy.Time.from_sec(step * 1e-3)
             wrench = WrenchStamped()
@@ -74,6 +77,8 @@ class RigReportTest(unittest.TestCase):
         self.assertEqual([row["global"] for row in rows], ["0", "1"])
         for figure in ["loading_curve.png", "precursors.png", "slip_map.png"]:
             self.assertTrue(os.path.exists(os.path.join(self.work, figure)), figure)
+        with open(os.path.join(self.work, "scene.yaml")) as scene:
+            self.assertEqual(scene.read(), SCENE)  # the scene as run, from the bag
 
     def test_the_detectors_events_on_request(self):
         done = self.report("--events", "detector")

@@ -1,6 +1,7 @@
 #include "friction_sim/ros/rig_simulator.h"
 
 #include <rosgraph_msgs/Clock.h>
+#include <std_msgs/String.h>
 
 #include <algorithm>
 #include <cmath>
@@ -135,6 +136,14 @@ void RigSimulator::advertise() {
   stop_srv_ = nh_.advertiseService("stop", &RigSimulator::onStop, this);
   abort_srv_ = nh_.advertiseService("abort", &RigSimulator::onAbort, this);
   run_end_srv_ = nh_.advertiseService("set_run_end", &RigSimulator::onSetRunEnd, this);
+  // What is run, overrides applied, for whoever joins later and in the bag: a recorded run can be
+  // analysed, or played back, with the scene it ran.
+  scene_pub_ = nh_.advertise<std_msgs::String>("scene", 1, true);
+  std_msgs::String scene;
+  scene.data = sceneToYaml(scene_);
+  scene_pub_.publish(scene);
+  // Stamped at the bag's earliest time: a bag cannot hold a zero stamp.
+  if (bag_open_) bag_.write(scene_pub_.getTopic(), ros::Time(0, 1), scene);
 }
 
 template <class Message>

@@ -26,6 +26,8 @@
 //   slip_events (friction_msgs/SlipEvent)          when an event ends
 //   lattice (friction_msgs/LatticeSnapshot)
 //   stage_state (friction_msgs/StageState)
+//   scene (std_msgs/String, latched)               the scene as run, overrides applied, in the scene YAML
+//                                                  format (also the bag's first message)
 // Subscribed topics:
 //   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time)
 // Services:
@@ -158,7 +160,8 @@ class RigSimulator {
   double running_wall_time_ = 0.0;  ///< s, wall time spent running before running_since_
   ros::WallTime running_since_;     ///< when the simulation last began running (unpaused)
   double pace_origin_sim_ = 0.0;
-  ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_;
+  ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_,
+      scene_pub_;
   ros::Subscriber command_sub_;
   ros::ServiceServer command_srv_, pause_srv_, reset_srv_, stop_srv_, abort_srv_, run_end_srv_;
 };
