@@ -22,36 +22,37 @@ F_Z = 1920.0
 SCENE = "name: synthetic\nload: {normal_force: 1920}\n"
 
 
-def event(index, onset, shear_ratio, rupture_length):
+def event(index, onset, shear_ratio, rupture_length, slider_length=0.14):
     msg = SlipEvent()
     msg.header.stamp = rospy.Time.from_sec(onset + 0.001)
     msg.index, msg.onset_time, msg.end_time = index, onset, onset + 0.001
     msg.onset_shear_force, msg.onset_normal_force = shear_ratio * F_Z, F_Z
-    msg.rupture_length, msg.slider_length = rupture_length, 0.14
+    msg.rupture_length, msg.slider_length = rupture_length, slider_length
     msg.global_event = rupture_length == 0.14
     return msg
 
 
-def write_bag(path):
-    """Load cells and frames for 0.1 s, two events from the simulator and the same two, with the
-    detector's slightly later reading of F_X, from the detector."""
+def write_bag(path, namespace="/rig", detector=True, slider_length=0.14):
+    """Load cells and frames for 0.1 s, two events from the simulator and, unless not `detector`, the same
+    two, with the detector's slightly later reading of F_X, from the detector."""
     with rosbag.Bag(path, "w") as bag:
-        bag.write("/rig/scene", String(data=SCENE), rospy.Time(0, 1))
+        bag.write(namespace + "/scene", String(data=SCENE), rospy.Time(0, 1))
         for step in range(1, 101):
             stamp = rospy.Time.from_sec(step * 1e-3)
             wrench = WrenchStamped()
             wrench.header.stamp = stamp
             wrench.wrench.force.x, wrench.wrench.force.z = 4.0 * step, -F_Z
-            bag.write("/rig/load_cells", wrench, stamp)
+            bag.write(namespace + "/load_cells", wrench, stamp)
             frame = InterfaceState()
             frame.header.stamp = stamp
             frame.position = [0.0, 0.07, 0.14]
             frame.slip_velocity = [0.0, 0.0, 0.0]
             frame.state = [0, 0, 0]
-            bag.write("/rig/interface", frame, stamp)
-        for source, later in [("/rig/slip_events", 0.0), ("/rig/precursor_detector/slip_events", 1e-4)]:
-            for msg in [event(0, 0.03, 0.1 + later, 0.05), event(1, 0.08, 0.2 + later, 0.14)]:
-                bag.write(source, msg, msg.header.stamp)
+            bag.write(namespace + "/interface", frame, stamp)
+        sources = [("/slip_events", 0.0)] + ([("/precursor_detector/slip_events", 1e-4)] if detector else [])
+        for source, later in sources:
+            for msg in [event(0, 0.03, 0.1 + later, 0.05, slider_length), event(1, 0.08, 0.2 + later, 0.14, slider_length)]:
+                bag.write(namespace + source, msg, msg.header.stamp)
 
 
 class RigReportTest(unittest.TestCase):
@@ -85,11 +86,28 @@ class RigReportTest(unittest.TestCase):
         self.assertEqual(done.returncode, 0, done.stderr)
         self.assertEqual([row["shear_ratio"] for row in self.table()], ["0.10010", "0.20010"])
 
-    def test_a_bag_without_the_rigs_load_cells_is_refused_naming_its_topics(self):
+    def test_a_bag_without_the_topics_asked_for_is_refused_naming_its_topics(self):
         done = self.report("--ns", "bench")
         self.assertNotEqual(done.returncode, 0)
         self.assertIn("holds no /bench/load_cells; its topics:", done.stderr)
         self.assertIn("/rig/load_cells", done.stderr)
+        write_bag(self.bag, detector=False)  # as the simulator records it: no detector
+        done = self.report("--events", "detector")
+        self.assertNotEqual(done.returncode, 0)
+        self.assertIn("holds no /rig/precursor_detector/slip_events; its topics:", done.stderr)
+
+    def test_the_rig_is_found_in_any_namespace(self):
+        write_bag(self.bag, namespace="/bench")
+        done = self.report()
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertEqual([row["shear_ratio"] for row in self.table()], ["0.10000", "0.20000"])
+
+    def test_an_unknown_slider_length_gives_no_length_ratio(self):
+        # The detector's events on a single block without a scene carry L = 0.
+        write_bag(self.bag, slider_length=0.0)
+        done = self.report()
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertEqual([row["length_ratio"] for row in self.table()], ["nan", "nan"])
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@ struct SlipEvent {
   double nucleation_position = 0.0;  ///< m, mean x of the nodes that unstuck first
   double slip_min_x = 0.0;          ///< m, smallest x of a node that slipped
   double slip_max_x = 0.0;          ///< m, largest x of a node that slipped
-  double rupture_length = 0.0;      ///< m, L_p = slip_max_x − slip_min_x
+  double rupture_length = 0.0;      ///< m, L_p = slip_max_x − slip_min_x (L for one node: measureExtent)
   bool global = false;              ///< every interface node slipped
   std::vector<double> node_slip;    ///< m, per interface node, displacement during the event
   std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
