@@ -13,6 +13,7 @@ import rosunit
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 LAUNCH = os.path.join(ROOT, "launch")
 RIG_RVIZ = os.path.join(ROOT, "friction_rviz/config/rig.rviz")
+RIG_PANEL = os.path.join(ROOT, "friction_rviz/src/rig_panel.cpp")
 
 
 def load(launch_file, *args):
@@ -39,7 +40,10 @@ def names_in_rig_rviz():
         text = config.read()
     topics = re.findall(r"^\s*Topic: (\S+)", text, re.M)
     namespace = re.search(r"^\s*Namespace: (\S+)", text, re.M).group(1)
-    panel = ["load_cells", "slip_events", "stage_state", "send_command", "pause"]
+    with open(RIG_PANEL) as source:
+        # The panel's subscriptions and service clients, read from its source: a new one is checked too.
+        panel = re.findall(r"rig\.(?:subscribe|serviceClient<[^>]+>)\(\s*\"(\w+)\"", source.read())
+    assert len(panel) >= 5, panel
     return topics + [namespace + "/" + name for name in panel]
 
 
@@ -67,6 +71,13 @@ class LaunchFilesTest(unittest.TestCase):
         self.assertEqual(config.params["/bench/simulator/bag"].value, "/scratch/run.bag")
         self.assertEqual(config.params["/bench/simulator/real_time_factor"].value, 0.5)
         self.check_rviz_follows(config, "bench")
+        # The rig's other arguments reach it too: without controller and analysis, the simulator alone.
+        alone = load("multi_machine.launch", "compute_host:=hpc1", "compute_env:=/x", "controller:=false",
+                     "analysis:=false", "rviz:=false", "required:=false")
+        self.assertEqual(sorted(n.name for n in alone.nodes), ["simulator"])
+        self.assertFalse(node(alone, "simulator").required)
+        self.assertEqual(config.params["/bench/simulator/start_paused"].value, True)
+        self.assertEqual(alone.params["/rig/simulator/start_paused"].value, False)
 
     def test_the_rig_runs_on_this_machine_by_default(self):
         config = load("rig.launch")
