@@ -9,6 +9,7 @@
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/lattice_2d.h"
+#include "friction_sim/simulation.h"
 #include "friction_sim/slip_events.h"
 #include "test_helpers.h"
 
@@ -166,6 +167,8 @@ TEST(LatticePusher, PushesTheRowNearestItsHeightOrItsBandAndSaysWhere) {
   const Lattice2D band(scene);
   EXPECT_EQ(band.pushedRows(), (std::vector<int>{2, 3, 4}));
   EXPECT_DOUBLE_EQ(band.pushingHeight(), 0.0075);
+  // What the lattice snapshot carries to rviz.
+  EXPECT_DOUBLE_EQ(Simulation(scene).snapshot().pusher_height, 0.0075);
 }
 
 TEST(LatticeNodeStiffness, BulkNodeThreeKAndCornerFiveQuarterK) {

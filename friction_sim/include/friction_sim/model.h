@@ -140,8 +140,9 @@ class Model {
   /// unstretched to the current displacements with the stage at position 0.
   virtual void disconnectPusher() = 0;
   virtual void connectPusher(const Vector& u) = 0;
-  /// m, rest height above the interface at which the pusher's resultant acts: the pushed row's (the
-  /// lattice's nearest to the scene's h, or its band's mean), or h where the model places it as given.
+  /// m, rest height above the interface of the pushed nodes: the pushed row's (the lattice's nearest to
+  /// the scene's h), a band's mean row height (near where the resultant acts: its rows' springs stretch
+  /// a little unequally), or h where the model places it as given (the chain's torque term).
   virtual double pushingHeight() const = 0;
 
   /// N, sets the normal load F_Z.

@@ -27,9 +27,9 @@ class ConfigError : public std::runtime_error {
   std::vector<std::string> problems_;
 };
 
-/// Appends "field: value V is not allowed; allowed: A" to `problems` unless `ok`: the one form of every
-/// refusal of a setting, in files and node parameters alike. V with ten digits; NaN as "nan", whatever
-/// its sign bit.
+/// Appends "field: value V is not allowed; allowed: A" to `problems` unless `ok`: the one form of the
+/// refusals of a scene's, a protocol's and a node's settings (a command's refusal says what it asked
+/// for in its own words). V with ten digits; NaN as "nan", whatever its sign bit.
 void requireSetting(bool ok, const std::string& field, double value, const std::string& allowed,
                     std::vector<std::string>& problems);
 

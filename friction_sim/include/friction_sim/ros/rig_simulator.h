@@ -48,7 +48,8 @@
 // parameter is refused, 4 when the run was aborted.
 //
 // Commands with NaN/inf, a normal load <= 0, a speed beyond the scene's stage.max_speed or an unknown
-// mode are refused with a logged reason; the simulation keeps running.
+// mode are refused with a logged reason; the simulation keeps running. A HOLD's speed and target are
+// ignored: a hold has none.
 #pragma once
 
 #include <friction_msgs/SendStageCommand.h>
