@@ -60,6 +60,7 @@ struct Observed {
   int refused_command_status = 0, aborts_after_refused_command = 0, stops_after_refused_command = 0,
       unpauses_after_refused_command = 0;
   int reset_controller_status = -1, commands_around_reset = 0, run_ends_around_reset = 0, unpauses_around_reset = 0;
+  std::string reset_controller_output;
 };
 Observed g_seen;
 std::string g_bag;
@@ -197,8 +198,7 @@ void runControllerThroughAResetAtTheStart(const std::string& protocol) {
         response.success = true;
       });
   simulator.announce(0, 0.0, 0, true);
-  std::string output;
-  g_seen.reset_controller_status = simulator.runController(protocol, "_start_delay:=0", output);
+  g_seen.reset_controller_status = simulator.runController(protocol, "_start_delay:=0", g_seen.reset_controller_output);
 }
 
 bool bagReadable(const std::string& path) {
@@ -347,7 +347,7 @@ TEST(FullRun, ControllerStartsOverAfterAResetThatCameBeforeTimeMovedOn) {
   std::string protocol;
   pnh.getParam("protocol", protocol);
   const std::size_t schedule = scheduleProtocol(loadProtocol(protocol), 0.0, 1920.0).size();
-  EXPECT_EQ(g_seen.reset_controller_status, 0);
+  EXPECT_EQ(g_seen.reset_controller_status, 0) << g_seen.reset_controller_output;
   EXPECT_EQ(g_seen.commands_around_reset, static_cast<int>(2 * schedule));
   EXPECT_EQ(g_seen.run_ends_around_reset, 2);
   EXPECT_EQ(g_seen.unpauses_around_reset, 2);

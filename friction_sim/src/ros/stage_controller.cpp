@@ -38,22 +38,37 @@ bool endSimulatorRun(ros::NodeHandle& nh, const std::string& service, ros::WallD
 
 StageController::StageController(ros::NodeHandle nh, LoadingProtocol protocol, double start_delay)
     : nh_(std::move(nh)), protocol_(std::move(protocol)), start_delay_(start_delay) {
-  command_client_ = nh_.serviceClient<friction_msgs::SendStageCommand>("send_command");
   pause_client_ = nh_.serviceClient<std_srvs::SetBool>("pause");
   run_end_client_ = nh_.serviceClient<friction_msgs::SetRunEnd>("set_run_end");
   state_sub_ = nh_.subscribe("stage_state", 100, &StageController::onStageState, this);
+}
+
+bool StageController::connectCommands(ros::Duration wait) {
+  // Persistent: a protocol's few dozen commands go over one connection, not one lookup and one
+  // connection each. Made once the service exists: a persistent client that found none stays invalid.
+  if (!ros::service::waitForService(nh_.resolveName("send_command"), wait)) return false;
+  command_client_ = nh_.serviceClient<friction_msgs::SendStageCommand>("send_command", true);
+  return true;
+}
+
+bool StageController::sendCommand(friction_msgs::SendStageCommand& call) {
+  if (command_client_.call(call)) return true;
+  // Once more over a new connection before the command counts as lost: a persistent link ends when the
+  // simulator's node restarts, and a call can fail on a loaded machine.
+  ROS_WARN("stage controller: send_command failed; reconnecting");
+  return connectCommands(ros::Duration(5.0)) && command_client_.call(call);
 }
 
 void StageController::start(double time, double normal_force) {
   started_ = true;
   ended_ = false;
   start_time_ = time;
-  command_client_.waitForExistence();
+  if (!command_client_.isValid()) connectCommands(ros::Duration(-1));  // waits for the simulator
   int refused = 0;
   for (const TimedCommand& command : scheduleProtocol(protocol_, time, normal_force)) {
     friction_msgs::SendStageCommand call;
     call.request.command = toMsg(command);
-    if (!command_client_.call(call)) {
+    if (!sendCommand(call)) {
       ROS_ERROR("stage controller: send_command failed (is the simulator running?)");
       ++refused;
     } else if (!call.response.accepted) {

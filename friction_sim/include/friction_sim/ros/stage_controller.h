@@ -25,6 +25,7 @@
 // stage state's reset count changes (a reset), it starts the protocol again from the new time.
 #pragma once
 
+#include <friction_msgs/SendStageCommand.h>
 #include <friction_msgs/StageState.h>
 #include <ros/ros.h>
 
@@ -63,6 +64,10 @@ class StageController {
  private:
   void onStageState(const friction_msgs::StageState::ConstPtr& msg);
   void start(double time, double normal_force);
+  /// Connects to send_command once it exists, waiting at most `wait` (negative: for ever).
+  bool connectCommands(ros::Duration wait);
+  /// Calls send_command, once more on a new connection if the call fails; false if both failed.
+  bool sendCommand(friction_msgs::SendStageCommand& call);
 
   ros::NodeHandle nh_;
   LoadingProtocol protocol_;
