@@ -27,31 +27,53 @@ DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh) {
   return options;
 }
 
-DetectorSettings resolveDetectorSettings(const DetectorOptions& options) {
+DetectorSettings detectorSettings(const Scene* scene, int front_fit_nodes) {
   DetectorSettings settings;
-  if (!options.scene_path.empty()) {
-    std::vector<std::string> ignored;  // validateDetectorOptions has refused malformed overrides
-    const Scene scene = loadScene(options.scene_path, parseOverrides(options.overrides, ignored));
-    settings.wave_speeds = waveSpeeds(scene);
-    settings.front_fit_nodes = scene.instruments.front_fit_nodes;
-    settings.slider_length = scene.geometry.length;
+  if (scene) {
+    settings.wave_speeds = waveSpeeds(*scene);
+    settings.front_fit_nodes = scene->instruments.front_fit_nodes;
+    settings.slider_length = scene->geometry.length;
   }
-  if (options.front_fit_nodes != 0) settings.front_fit_nodes = options.front_fit_nodes;
+  if (front_fit_nodes != 0) settings.front_fit_nodes = front_fit_nodes;
   return settings;
 }
 
+DetectorSettings resolveDetectorSettings(const DetectorOptions& options) {
+  if (options.scene_path.empty()) return detectorSettings(nullptr, options.front_fit_nodes);
+  std::vector<std::string> ignored;  // validateDetectorOptions has refused malformed overrides
+  const Scene scene = loadScene(options.scene_path, parseOverrides(options.overrides, ignored));
+  return detectorSettings(&scene, options.front_fit_nodes);
+}
+
 PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private_nh, const DetectorOptions& options)
-    : nh_(std::move(nh)), private_nh_(std::move(private_nh)) {
-  const DetectorSettings settings = resolveDetectorSettings(options);
-  wave_speeds_ = settings.wave_speeds;
-  detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, wave_speeds_.longitudinal,
-                                                   settings.slider_length);
+    : nh_(std::move(nh)), private_nh_(std::move(private_nh)), front_fit_nodes_option_(options.front_fit_nodes) {
+  use(resolveDetectorSettings(options));
+  // Without ~scene, the run's own: the simulator publishes it (latched), and a bag holds it first.
+  if (options.scene_path.empty()) scene_sub_ = nh_.subscribe("scene", 1, &PrecursorDetector::onScene, this);
   events_pub_ = private_nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   points_pub_ = private_nh_.advertise<friction_msgs::PrecursorPoint>("precursor_points", 1000, true);
   // Deep queues: a bag played fast must not drop frames, or events would be merged.
   const auto hints = ros::TransportHints().tcpNoDelay();
   load_cells_sub_ = nh_.subscribe("load_cells", 100000, &PrecursorDetector::onLoadCells, this, hints);
   interface_sub_ = nh_.subscribe("interface", 100000, &PrecursorDetector::onFrame, this, hints);
+}
+
+void PrecursorDetector::use(const DetectorSettings& settings) {
+  wave_speeds_ = settings.wave_speeds;
+  detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, wave_speeds_.longitudinal,
+                                                   settings.slider_length);
+}
+
+void PrecursorDetector::onScene(const std_msgs::String::ConstPtr& msg) {
+  try {
+    const Scene scene = parseScene(msg->data);
+    // A new detector: what the old one had seen was measured against another scene (or none).
+    use(detectorSettings(&scene, front_fit_nodes_option_));
+    ROS_INFO_STREAM("precursor detector: using the run's scene " << scene.name << " (c_S = " << wave_speeds_.shear
+                                                                 << " m/s, L = " << scene.geometry.length << " m)");
+  } catch (const ConfigError& error) {
+    ROS_WARN_STREAM("precursor detector: the run's scene is refused, wave speeds stay unknown: " << error.what());
+  }
 }
 
 void PrecursorDetector::checkTime(const ros::Time& stamp) {

@@ -8,13 +8,16 @@
 //                              instruments.front_fit_nodes (as the simulator fits), 5 without a scene
 //   scene (string, "")         the run's scene YAML: its model's wave speeds go into the events, so that
 //                              v_c/c_R and v_c/c_S can be read off them (the instruments do not tell
-//                              them, as a lab takes c_R of its PMMA from the literature); "" = unknown (0).
-//                              Its geometry.length is the L of L_p/L, as the simulator's; without it L is
-//                              the span of the interface nodes (none for a single block: L_p/L is NaN)
+//                              them, as a lab takes c_R of its PMMA from the literature). Its
+//                              geometry.length is the L of L_p/L, as the simulator's. "" = the scene the
+//                              `scene` topic brings (the simulator's, live or from its bag); until one
+//                              comes, the speeds are unknown (0) and L is the span of the interface nodes
+//                              (none for a single block: L_p/L is NaN)
 //                              Validated as the simulator does (a 10^6-node lattice's takes ~15 s)
 //   overrides (string, "")     the run's scene overrides, "key=value key=value", as the simulator's
 // Subscribed topics (relative to the node's namespace):
 //   load_cells (geometry_msgs/WrenchStamped), interface (friction_msgs/InterfaceState)
+//   scene (std_msgs/String)    without ~scene only: the run's scene; its arrival starts the analysis over
 // Published topics (private), in the interface frames' frame_id:
 //   ~slip_events (friction_msgs/SlipEvent), ~precursor_points (friction_msgs/PrecursorPoint)
 //
@@ -26,6 +29,7 @@
 #include <friction_msgs/InterfaceState.h>
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/ros.h>
+#include <std_msgs/String.h>
 
 #include <memory>
 #include <string>
@@ -53,6 +57,8 @@ struct DetectorSettings {
   int front_fit_nodes = 5;  ///< the options' or the scene's
   double slider_length = 0.0;  ///< m, L of L_p/L: the scene's geometry.length; 0 without a scene
 };
+/// The settings from a run's `scene` (nullptr: none), with the ~front_fit_nodes option (0: the scene's).
+DetectorSettings detectorSettings(const Scene* scene, int front_fit_nodes);
 /// Loads the options' scene, if any; throws ConfigError if it is refused.
 DetectorSettings resolveDetectorSettings(const DetectorOptions& options);
 
@@ -64,15 +70,18 @@ class PrecursorDetector {
   void onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr& msg);
   void onFrame(const friction_msgs::InterfaceState::ConstPtr& msg);
   void checkTime(const ros::Time& stamp);
+  void use(const DetectorSettings& settings);
+  void onScene(const std_msgs::String::ConstPtr& msg);
   void publishCompleted();
 
   ros::NodeHandle nh_, private_nh_;
   std::unique_ptr<FrameEventDetector> detector_;
+  int front_fit_nodes_option_;  ///< ~front_fit_nodes, 0 = the scene's
   WaveSpeeds wave_speeds_;
   std::vector<double> positions_;
   std::string frame_id_;  ///< the interface frames', for the events
   ros::Time last_stamp_;
-  ros::Subscriber load_cells_sub_, interface_sub_;
+  ros::Subscriber load_cells_sub_, interface_sub_, scene_sub_;
   ros::Publisher events_pub_, points_pub_;
 };
 
