@@ -61,6 +61,8 @@ struct Observed {
       unpauses_after_refused_command = 0;
   int reset_controller_status = -1, commands_around_reset = 0, run_ends_around_reset = 0, unpauses_around_reset = 0;
   std::string reset_controller_output;
+  int failed_call_controller_status = -1, commands_with_a_failed_call = 0;
+  std::string failed_call_controller_output;
 };
 Observed g_seen;
 std::string g_bag;
@@ -97,16 +99,20 @@ class StandInSimulator {
     nh_.setCallbackQueue(&queue_);
     state_ = nh_.advertise<friction_msgs::StageState>("stage_state", 1, true);
   }
+  /// Serves `name` with `callback`, whose false fails the call.
+  template <class Service>
+  void serve(const std::string& name,
+             const boost::function<bool(typename Service::Request&, typename Service::Response&)>& callback) {
+    services_.push_back(nh_.advertiseService(name, callback));
+  }
   /// Answers the service `name` with `reply` (which fills the response) and true.
   template <class Service>
   void answer(const std::string& name,
               std::function<void(typename Service::Request&, typename Service::Response&)> reply) {
-    const boost::function<bool(typename Service::Request&, typename Service::Response&)> callback =
-        [reply](typename Service::Request& request, typename Service::Response& response) {
-          reply(request, response);
-          return true;
-        };
-    services_.push_back(nh_.advertiseService(name, callback));
+    serve<Service>(name, [reply](typename Service::Request& request, typename Service::Response& response) {
+      reply(request, response);
+      return true;
+    });
   }
   /// Counts the calls to its Trigger service `name` (stop, abort) in `calls`.
   void countCalls(const std::string& name, int& calls) {
@@ -199,6 +205,29 @@ void runControllerThroughAResetAtTheStart(const std::string& protocol) {
       });
   simulator.announce(0, 0.0, 0, true);
   g_seen.reset_controller_status = simulator.runController(protocol, "_start_delay:=0", g_seen.reset_controller_output);
+}
+
+/// A controller whose simulator fails the first send_command call (as a lost connection would) and
+/// takes every other command, then announces the protocol's end when unpaused.
+void runControllerThroughAFailedCall(const std::string& protocol) {
+  StandInSimulator simulator("/failed_call");
+  simulator.serve<friction_msgs::SendStageCommand>(
+      "send_command", [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
+        response.accepted = true;
+        return ++g_seen.commands_with_a_failed_call > 1;
+      });
+  simulator.answer<friction_msgs::SetRunEnd>(
+      "set_run_end", [](friction_msgs::SetRunEnd::Request&, friction_msgs::SetRunEnd::Response& response) {
+        response.accepted = true;
+      });
+  simulator.answer<std_srvs::SetBool>(
+      "pause", [&simulator](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
+        if (!request.data) simulator.announce(0, 0.1, 2, false);
+        response.success = true;
+      });
+  simulator.announce(0, 0.0, 0, true);
+  g_seen.failed_call_controller_status =
+      simulator.runController(protocol, "_start_delay:=0", g_seen.failed_call_controller_output);
 }
 
 bool bagReadable(const std::string& path) {
@@ -340,6 +369,19 @@ TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
   EXPECT_EQ(g_seen.unpauses_after_refused_command, 0);
 }
 
+TEST(FullRun, ControllerSendsACommandAgainWhenItsCallFailsAndRunsTheProtocol) {
+  // The failed call is sent once more on a new connection: every command arrives, the run is not
+  // aborted, and the controller exits cleanly at the protocol's end.
+  ros::NodeHandle pnh("~");
+  std::string protocol;
+  pnh.getParam("protocol", protocol);
+  const std::size_t schedule = scheduleProtocol(loadProtocol(protocol), 0.0, 1920.0).size();
+  EXPECT_EQ(g_seen.commands_with_a_failed_call, static_cast<int>(schedule + 1));
+  EXPECT_EQ(g_seen.failed_call_controller_status, 0) << g_seen.failed_call_controller_output;
+  EXPECT_NE(g_seen.failed_call_controller_output.find("send_command failed; reconnecting"), std::string::npos)
+      << g_seen.failed_call_controller_output;
+}
+
 TEST(FullRun, ControllerStartsOverAfterAResetThatCameBeforeTimeMovedOn) {
   // The schedule and the run end are sent again after the reset; the simulator ends the run at the
   // protocol's end, and the controller exits cleanly.
@@ -370,6 +412,8 @@ TEST(FullRun, BagHoldsTheSceneAsRunFirst) {
   rosbag::View everything(bag);
   ASSERT_GT(everything.size(), 0u);
   EXPECT_EQ(everything.begin()->getTopic(), "/rig/scene");
+  // Latched, so that a bag played before its listeners connect still gives it to them.
+  EXPECT_EQ(everything.begin()->getConnectionHeader()->at("latching"), "1");
 }
 
 void expectPointsMatchEvents(const std::vector<friction_msgs::PrecursorPoint>& points) {
@@ -495,6 +539,7 @@ void watchFullRun(ros::NodeHandle& nh) {
     pnh.getParam("protocol", protocol);
     runProtocolAgainstARefusingSimulator(protocol);
     runControllerThroughAResetAtTheStart(protocol);
+    runControllerThroughAFailedCall(protocol);
   }
   // The controller ends the run after two global events; the simulator then closes its bag.
   waitFor([] { return bagReadable(g_bag); }, 240.0);

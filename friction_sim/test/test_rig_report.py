@@ -32,10 +32,17 @@ def event(index, onset, shear_ratio, rupture_length, slider_length=0.14):
     return msg
 
 
-def write_bag(path, namespace="/rig", detector=True, slider_length=0.14):
+def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None):
     """Load cells and frames for 0.1 s, two events from the simulator and, unless not `detector`, the same
-    two, with the detector's slightly later reading of F_X, from the detector."""
+    two, with the detector's slightly later reading of F_X, from the detector; `also` another rig's
+    namespace with the same."""
+    if also:
+        write_bag(path + ".also", also, detector, slider_length)
     with rosbag.Bag(path, "w") as bag:
+        if also:
+            with rosbag.Bag(path + ".also") as other:
+                for topic, msg, stamp in other.read_messages():
+                    bag.write(topic, msg, stamp)
         bag.write(namespace + "/scene", String(data=SCENE), rospy.Time(0, 1))
         for step in range(1, 101):
             stamp = rospy.Time.from_sec(step * 1e-3)
@@ -96,11 +103,18 @@ class RigReportTest(unittest.TestCase):
         self.assertNotEqual(done.returncode, 0)
         self.assertIn("holds no /rig/precursor_detector/slip_events; its topics:", done.stderr)
 
-    def test_the_rig_is_found_in_any_namespace(self):
-        write_bag(self.bag, namespace="/bench")
+    def test_the_rig_is_found_in_any_namespace_or_chosen_among_several(self):
+        for namespace in ["/bench", ""]:  # "": the root namespace, topics /load_cells ...
+            write_bag(self.bag, namespace=namespace)
+            done = self.report()
+            self.assertEqual(done.returncode, 0, done.stderr)
+            self.assertEqual([row["shear_ratio"] for row in self.table()], ["0.10000", "0.20000"])
+        write_bag(self.bag, namespace="/bench", also="/rig")
         done = self.report()
+        self.assertNotEqual(done.returncode, 0)
+        self.assertIn("holds several rigs; choose one with --ns: /bench/ | /rig/", done.stderr)
+        done = self.report("--ns", "rig")
         self.assertEqual(done.returncode, 0, done.stderr)
-        self.assertEqual([row["shear_ratio"] for row in self.table()], ["0.10000", "0.20000"])
 
     def test_an_unknown_slider_length_gives_no_length_ratio(self):
         # The detector's events on a single block without a scene carry L = 0.

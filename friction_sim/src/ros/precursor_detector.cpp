@@ -65,14 +65,21 @@ void PrecursorDetector::use(const DetectorSettings& settings) {
 }
 
 void PrecursorDetector::onScene(const std_msgs::String::ConstPtr& msg) {
+  // A new detector either way: what the old one saw was measured against another scene, or none. The
+  // scene is its bag's first message, but it travels apart from the frames, which may come first.
+  if (frames_seen_ > 0) {
+    ROS_WARN_STREAM("precursor detector: the run's scene came after " << frames_seen_
+                                                                      << " interface frames; starting over without them");
+  }
+  frames_seen_ = 0;
   try {
     const Scene scene = parseScene(msg->data);
-    // A new detector: what the old one had seen was measured against another scene (or none).
     use(detectorSettings(&scene, front_fit_nodes_option_));
     ROS_INFO_STREAM("precursor detector: using the run's scene " << scene.name << " (c_S = " << wave_speeds_.shear
                                                                  << " m/s, L = " << scene.geometry.length << " m)");
   } catch (const ConfigError& error) {
-    ROS_WARN_STREAM("precursor detector: the run's scene is refused, wave speeds stay unknown: " << error.what());
+    use(detectorSettings(nullptr, front_fit_nodes_option_));
+    ROS_WARN_STREAM("precursor detector: the run's scene is refused, so the wave speeds are unknown: " << error.what());
   }
 }
 
@@ -94,6 +101,7 @@ void PrecursorDetector::onFrame(const friction_msgs::InterfaceState::ConstPtr& m
   checkTime(msg->header.stamp);
   positions_ = msg->position;
   frame_id_ = msg->header.frame_id;
+  ++frames_seen_;
   detector_->addFrame(fromMsg(*msg));
   publishCompleted();
 }

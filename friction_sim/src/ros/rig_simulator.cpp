@@ -1,5 +1,6 @@
 #include "friction_sim/ros/rig_simulator.h"
 
+#include <boost/make_shared.hpp>
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/String.h>
 
@@ -142,8 +143,17 @@ void RigSimulator::advertise() {
   std_msgs::String scene;
   scene.data = sceneToYaml(scene_);
   scene_pub_.publish(scene);
-  // Stamped at the bag's earliest time: a bag cannot hold a zero stamp.
-  if (bag_open_) bag_.write(scene_pub_.getTopic(), ros::Time(0, 1), scene);
+  if (bag_open_) {
+    // Latched in the bag too, so that rosbag play latches it for whoever subscribes late; stamped at
+    // the bag's earliest time (a bag cannot hold a zero stamp).
+    auto header = boost::make_shared<ros::M_string>();
+    (*header)["type"] = ros::message_traits::datatype(scene);
+    (*header)["md5sum"] = ros::message_traits::md5sum(scene);
+    (*header)["message_definition"] = ros::message_traits::definition(scene);
+    (*header)["callerid"] = ros::this_node::getName();
+    (*header)["latching"] = "1";
+    bag_.write(scene_pub_.getTopic(), ros::Time(0, 1), scene, header);
+  }
 }
 
 template <class Message>

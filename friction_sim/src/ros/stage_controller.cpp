@@ -54,7 +54,9 @@ bool StageController::connectCommands(ros::Duration wait) {
 bool StageController::sendCommand(friction_msgs::SendStageCommand& call) {
   if (command_client_.call(call)) return true;
   // Once more over a new connection before the command counts as lost: a persistent link ends when the
-  // simulator's node restarts, and a call can fail on a loaded machine.
+  // simulator's node restarts, and a call can fail on a loaded machine. If the failed call did reach the
+  // simulator, it now holds the command twice, which is harmless: a command says what to do and when
+  // (a speed, a target, an F_Z at a simulated time), not by how much to change.
   ROS_WARN("stage controller: send_command failed; reconnecting");
   return connectCommands(ros::Duration(5.0)) && command_client_.call(call);
 }
@@ -63,7 +65,8 @@ void StageController::start(double time, double normal_force) {
   started_ = true;
   ended_ = false;
   start_time_ = time;
-  if (!command_client_.isValid()) connectCommands(ros::Duration(-1));  // waits for the simulator
+  // Waits for the simulator; fails only when ROS shuts down.
+  if (!command_client_.isValid() && !connectCommands(ros::Duration(-1))) return;
   int refused = 0;
   for (const TimedCommand& command : scheduleProtocol(protocol_, time, normal_force)) {
     friction_msgs::SendStageCommand call;

@@ -80,6 +80,7 @@ class PrecursorDetector {
   WaveSpeeds wave_speeds_;
   std::vector<double> positions_;
   std::string frame_id_;  ///< the interface frames', for the events
+  long frames_seen_ = 0;  ///< interface frames since the analysis last started over
   ros::Time last_stamp_;
   ros::Subscriber load_cells_sub_, interface_sub_, scene_sub_;
   ros::Publisher events_pub_, points_pub_;
