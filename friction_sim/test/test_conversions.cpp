@@ -126,7 +126,8 @@ TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
   const Simulation simulation(scene);
   friction_msgs::StageCommand msg;
   msg.mode = friction_msgs::StageCommand::VELOCITY;
-  msg.speed = std::nan("");
+  msg.speed = -std::nan("");
+  EXPECT_NE(checkCommand(msg, simulation).find("speed nan m/s"), std::string::npos) << checkCommand(msg, simulation);
   EXPECT_NE(checkCommand(msg, simulation).find("finite"), std::string::npos);
   msg.speed = 2.0;
   EXPECT_NE(checkCommand(msg, simulation).find("max_speed"), std::string::npos);

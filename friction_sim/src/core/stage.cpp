@@ -51,7 +51,17 @@ double Stage::timeToNextChange() const {
 std::string Stage::checkCommand(const StageCommand& command) const {
   std::ostringstream reason;
   if (!std::isfinite(command.speed) || !std::isfinite(command.target)) {
-    reason << "speed " << command.speed << " m/s and target " << command.target << " m must be finite";
+    // NaN as "nan" whatever its sign bit, which the sender's arithmetic decides ("-nan" reads as a value).
+    auto text = [](double value) {
+      std::ostringstream number;
+      if (std::isnan(value)) {
+        number << "nan";
+      } else {
+        number << value;
+      }
+      return number.str();
+    };
+    reason << "speed " << text(command.speed) << " m/s and target " << text(command.target) << " m must be finite";
   } else if (std::abs(command.speed) > spec_.max_speed) {
     reason << "speed " << command.speed << " m/s exceeds the stage's max_speed " << spec_.max_speed << " m/s";
   } else if (command.mode == StageMode::Position && command.speed <= 0.0) {
