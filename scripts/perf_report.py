@@ -105,7 +105,7 @@ def errors(result, reference):
                 + [0.0])
     length = max([abs(float(a["rupture_length_m"]) - float(b["rupture_length_m"])) for a, b in zip(mine, ref)] + [0.0])
     g, gr = first_global(result["events"]), first_global(reference["events"])
-    macro = abs(float(g["shear_ratio"]) / float(gr["shear_ratio"]) - 1) if g and gr else math.nan
+    macro = abs(float(g["peak_shear_ratio"]) / float(gr["peak_shear_ratio"]) - 1) if g and gr else math.nan
     speed = (abs(float(g["median_front_speed_m_s"]) / float(gr["median_front_speed_m_s"]) - 1)
              if g and gr else math.nan)
     return {"precursors": len(mine), "precursor_difference": len(mine) - len(ref), "shear": shear,

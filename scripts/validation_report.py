@@ -155,7 +155,7 @@ def by_value(runs):
 def macro_cell(events):
     """µ_s,macro of a run, or "none" without a global event."""
     g = first_global(events)
-    return "%.4f" % f(g, "shear_ratio") if g else "none"
+    return "%.4f" % f(g, "peak_shear_ratio") if g else "none"
 
 
 def spread_percent(values):
@@ -166,7 +166,12 @@ def global_row(label, events):
     """A table row: label, precursors before the first global event, µ_s,macro, its median front speed."""
     g = first_global(events)
     return "| %s | %d | %s | %s |" % (label, len(precursors(events)), macro_cell(events),
-                                      "%.0f" % f(g, "median_front_speed_m_s") if g else "-")
+                                      speed_cell(f(g, "median_front_speed_m_s")) if g else "-")
+
+
+def speed_cell(speed):
+    """m/s: whole metres for fronts near the wave speeds, two decimals for the slow ones."""
+    return "%.0f" % speed if abs(speed) >= 10 else "%.2f" % speed
 
 
 def scatter(ax, events, label, marker="o"):
@@ -175,7 +180,7 @@ def scatter(ax, events, label, marker="o"):
     g = first_global(events)
     line = ax.plot(xs, ys, marker=marker, linestyle="-", label=label, markersize=4)[0]
     if g:
-        ax.plot([f(g, "shear_ratio")], [1.0], marker="*", color=line.get_color(), markersize=9)
+        ax.plot([f(g, "peak_shear_ratio")], [1.0], marker="*", color=line.get_color(), markersize=9)
 
 
 def figure(name, panels):
@@ -223,7 +228,7 @@ def write(data):
     L += ["## 1. Precursors (MODEL.md §8.1)", "",
           "*Experiment*: precursors nucleate at the trailing edge, arrest, grow with F_X in discrete steps; global "
           "sliding follows the first front that crosses the whole interface.", "",
-          "*Rig*: %d precursors before the first global event at F_X/F_Z = %.4f:" % (len(pre), f(g, "shear_ratio")), "",
+          "*Rig*: %d precursors before the first global event at F_X/F_Z = %.4f:" % (len(pre), f(g, "peak_shear_ratio")), "",
           "| # | F_X/F_Z | L_p/L | nucleation x (mm) | median v_c (m/s) |", "|---|---|---|---|---|"]
     for e in pre:
         L.append("| %s | %.4f | %.3f | %.1f | %.0f |" % (e["index"], f(e, "shear_ratio"), f(e, "length_ratio"),
@@ -309,7 +314,7 @@ def write(data):
         before = precursors(v)
         counts.append(len(before))
         single.append(sum(1 for e in before if f(e, "rupture_length_m") == 0))
-        macros.append(f(gg, "shear_ratio") if gg else math.nan)
+        macros.append(f(gg, "peak_shear_ratio") if gg else math.nan)
     ax[0].plot(hs, counts, "o-")
     ax[0].set_xlabel("h (mm)")
     ax[0].set_ylabel("precursors before global slip")
@@ -507,9 +512,9 @@ def write(data):
         if fb and events:
             gg = first_global(events)
             L.append("| %s | %d | %.2f | %.4f | %.3f | %.3f | %.4f |" % (label, fb["n"], fb["alpha"], fb["fx0"], fb["r2"],
-                                                                    fb["predicted_macro"], f(gg, "shear_ratio") if gg else math.nan))
+                                                                    fb["predicted_macro"], f(gg, "peak_shear_ratio") if gg else math.nan))
     uniform_global = first_global(uniform) if uniform else None
-    miss_1d = abs(fb1["predicted_macro"] / f(uniform_global, "shear_ratio") - 1) if fb1 and uniform_global else math.nan
+    miss_1d = abs(fb1["predicted_macro"] / f(uniform_global, "peak_shear_ratio") - 1) if fb1 and uniform_global else math.nan
     L += ["", "*Agreement*: in 1D the points lie on the line (α = %.2f: the arrested region carries that share of "
           "µ_k times its normal load) and the line's µ_s,macro is off by %.1f %%; in 2D the few points also lie on a line but α differs: "
           "the slider's bending changes the normal load under the slipped region." % (fb1["alpha"] if fb1 else math.nan,
@@ -555,7 +560,7 @@ def write(data):
     for k, v in by_size:
         L.append(global_row(k.split("_time")[0], v))
     runs = [v for _, v in by_size]
-    macros = [f(first_global(v), "shear_ratio") for v in runs]
+    macros = [f(first_global(v), "peak_shear_ratio") for v in runs]
     speeds = [f(first_global(v), "median_front_speed_m_s") for v in runs]
     L += ["", "*Converged*: µ_s,macro (%s: within %.1f %%) and the global front speed (within %.1f %%). "
           "*Not converged*: the number of precursors (%s) — finer lattices split the loading into "

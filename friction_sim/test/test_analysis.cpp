@@ -8,6 +8,7 @@
 
 #include "friction_sim/frame_event_detector.h"
 #include "friction_sim/loading_protocol.h"
+#include "friction_sim/results_io.h"
 #include "friction_sim/simulation.h"
 #include "test_helpers.h"
 
@@ -239,6 +240,38 @@ TEST(FrameEventDetector, FindsTheSimulatorsEventsFromTheInstrumentsAlone) {
       EXPECT_NEAR(found[e].node_slip[node], truth[e].node_slip[node], 1e-12);
     }
   }
+}
+
+TEST(SlipEvents, AnInterfaceThatCreepsGivesWayAtItsPeakForceNotAtItsFirstUnsticking) {
+  // Slip weakening over ξ_µ = 10 µm is stable on the chain (its bonds, 5.4e8 N/m, are far stiffer than
+  // the weakening, (µ_s − µ_k)·w/ξ_µ ≈ 7.7e5 N/m): the first block unsticks at F_X = µ_s·F_Z/57 and the
+  // chain creeps on, taking load, in one event. Its peak is the largest F_X the load cell reads until
+  // the last block has slipped.
+  Scene scene = loadScene(testing::scenePath("pmma_1d_side"));
+  scene.friction.law = FrictionLawKind::SlipWeakening;
+  scene.friction.weakening_length = 1e-5;
+  Simulation simulation(scene);
+  std::vector<std::pair<double, double>> event_loads;  // (s, N): t and F_X at each step of the event
+  while (!simulation.finished()) {
+    simulation.step();
+    if (simulation.inEvent() || simulation.eventEndedLastStep()) {
+      event_loads.emplace_back(simulation.time(), simulation.loadCells().shear_force);
+    }
+  }
+  ASSERT_EQ(simulation.events().size(), 1u);
+  const SlipEvent& event = simulation.events()[0];
+  ASSERT_TRUE(event.global);
+  const double all_slipped = *std::max_element(event.first_unstick_time.begin(), event.first_unstick_time.end());
+  double largest = 0.0;
+  for (const auto& [time, shear_force] : event_loads) {
+    if (time <= all_slipped) largest = std::max(largest, shear_force);
+  }
+  EXPECT_NEAR(event.onset_shear_force, scene.friction.static_coefficient * scene.load.normal_force / 57, 1e-3);
+  // The step ends sample F_X; the peak, interpolated to the last first-unsticking, may exceed the last
+  // sample by one step of loading, K·V·dt = 3.2e-4 N.
+  EXPECT_NEAR(event.peak_shear_force, largest, 3.2e-4);
+  EXPECT_GT(event.peakShearRatio(), 10.0 * event.onset_shear_force / event.onset_normal_force);
+  EXPECT_EQ(summarize(simulation, 0.0).static_friction_macro, event.peakShearRatio());
 }
 
 TEST(FrameEventDetector, TheSingleBlocksSlipsSpanTheSliderAsTheSimulatorsDo) {

@@ -24,7 +24,8 @@ struct RunSummary {
   int precursors = 0;   ///< non-global events before the first global one
   int single_node_precursors = 0;  ///< of those, events in which one node alone slipped (L_p = 0): no front ran
   std::vector<PrecursorPoint> precursor_points;
-  double static_friction_macro = 0.0;  ///< µ_s,macro = F_X/F_Z at the first global event (NaN if none)
+  /// µ_s,macro = F_X/F_Z at the first global event, at its peak (SlipEvent::peak_shear_force; NaN if none)
+  double static_friction_macro = 0.0;
   /// µ_k,macro = mean F_X / mean F_Z over the first global event, from onset to end (NaN if none)
   double kinetic_friction_macro = 0.0;
   double simulated_time = 0.0;         ///< s

@@ -18,6 +18,14 @@ struct SlipEvent {
   double onset_shear_force = 0.0;   ///< N, F_X at onset (interpolated within the step)
   double onset_normal_force = 0.0;  ///< N, F_Z at onset
   double end_shear_force = 0.0;     ///< N, F_X at the end (interpolated within the step)
+  /// N, the F_X of largest magnitude from the onset until every interface node has slipped (until the
+  /// end if they never all do): the load the interface bore while it gave way. For a dynamic event it is
+  /// the onset's, as F_X drops while the front runs; an interface that creeps (slip weakening with a
+  /// long ξ_µ) goes on taking load after its first node unsticks and gives way as a whole later. Not
+  /// beyond that moment: a stage driven fast may load the sliding slider further (the single block).
+  double peak_shear_force = 0.0;
+  /// F_X/F_Z at the peak: µ_s,macro over a global event
+  double peakShearRatio() const { return peak_shear_force / onset_normal_force; }
   /// N, F_X averaged over time from onset to end; F_Z likewise. Their ratio over a global event is
   /// µ_k,macro (MODEL.md §6): where the slider is at rest before and after, the pusher's mean force is
   /// the interface's mean friction during the event (exactly so for the chain, whose blocks stand still
@@ -68,6 +76,8 @@ class SlipEventDetector {
   double slider_length_;  ///< m, L
   bool in_event_ = false;
   SlipEvent current_;
+  void notePeak(double shear_force);
+  std::size_t slipped_ = 0;      ///< nodes of the current event that have slipped so far
   double shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the current event so far
   double normal_impulse_ = 0.0;  ///< N·s, ∫F_Z dt
   std::vector<double> onset_u_;

@@ -39,12 +39,19 @@ std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents() {
     // (trapezoids) over the samples from the first of those to the second.
     const LoadCellReading* previous = nullptr;
     double shear_impulse = 0.0, normal_impulse = 0.0, span = 0.0;
+    // The peak F_X is watched until the whole interface has slipped (SlipEvent::peak_shear_force).
+    const double peak_until =
+        event.global ? *std::max_element(event.first_unstick_time.begin(), event.first_unstick_time.end())
+                     : event.end_time;
     for (const LoadCellReading& reading : load_cells_) {
       if (reading.time <= event.onset_time) {
-        event.onset_shear_force = reading.shear_force;
+        event.onset_shear_force = event.peak_shear_force = reading.shear_force;
         event.onset_normal_force = reading.normal_force;
         previous = &reading;
       } else if (reading.time <= event.end_time && previous) {
+        if (reading.time <= peak_until && std::abs(reading.shear_force) > std::abs(event.peak_shear_force)) {
+          event.peak_shear_force = reading.shear_force;
+        }
         const double interval = reading.time - previous->time;
         shear_impulse += 0.5 * (previous->shear_force + reading.shear_force) * interval;
         normal_impulse += 0.5 * (previous->normal_force + reading.normal_force) * interval;

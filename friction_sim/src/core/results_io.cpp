@@ -17,7 +17,7 @@ RunSummary summarize(const Simulation& simulation, double wall_time) {
   summary.kinetic_friction_macro = std::numeric_limits<double>::quiet_NaN();
   for (const SlipEvent& event : simulation.events()) {
     if (event.global) {
-      summary.static_friction_macro = event.onset_shear_force / event.onset_normal_force;
+      summary.static_friction_macro = event.peakShearRatio();
       summary.kinetic_friction_macro = event.meanShearRatio();
       break;
     }
@@ -60,7 +60,7 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
   out << "index,onset_time_s,end_time_s,onset_shear_force_N,onset_normal_force_N,shear_ratio,"
          "end_shear_force_N,nucleation_x_m,slip_min_x_m,slip_max_x_m,rupture_length_m,length_ratio,global,"
          "median_front_speed_m_s,front_speed_over_c_s,front_speed_over_c_r,front_fits_left_out,"
-         "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio\n";
+         "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio,peak_shear_force_N,peak_shear_ratio\n";
   out << std::setprecision(12);
   const double slider_length = scene.geometry.length;
   const WaveSpeeds speeds = waveSpeeds(scene);
@@ -72,8 +72,8 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
         << ',' << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << e.median_front_speed
         << ',' << e.median_front_speed / speeds.shear << ','
         << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out
-        << ',' << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio()
-        << '\n';
+        << ',' << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio() << ','
+        << e.peak_shear_force << ',' << e.peakShearRatio() << '\n';
   }
 }
 

@@ -36,6 +36,8 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     current_.onset_time = step_start + dt;
     for (int node : unstuck) current_.onset_time = std::min(current_.onset_time, transition_time(node));
     current_.onset_shear_force = shear_at(current_.onset_time);
+    current_.peak_shear_force = current_.onset_shear_force;
+    slipped_ = 0;
     current_.onset_normal_force = loads.normal;
     shear_impulse_ = 0.0;
     normal_impulse_ = 0.0;
@@ -47,8 +49,13 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
   }
   if (!in_event_) return false;
+  const bool was_global = slipped_ == positions_.size();
+  double last_first_unstick = step_start;  // of the nodes slipping for the first time in this step
   for (int node : unstuck) {
-    if (std::isnan(current_.first_unstick_time[node])) current_.first_unstick_time[node] = transition_time(node);
+    if (!std::isnan(current_.first_unstick_time[node])) continue;
+    current_.first_unstick_time[node] = transition_time(node);
+    last_first_unstick = std::max(last_first_unstick, current_.first_unstick_time[node]);
+    ++slipped_;
   }
   const bool ended = contact.slidingCount() == 0;
   double end_time = step_start + dt;
@@ -56,6 +63,10 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     end_time = step_start;
     for (int node : contact.restuckLastStep()) end_time = std::max(end_time, transition_time(node));
   }
+  // The peak is watched until the whole interface has slipped. F_X is linear across the step, so its
+  // value where this step's part of the watch ends bounds it (the start was noted at the onset or by
+  // the step before).
+  if (!was_global) notePeak(shear_at(slipped_ == positions_.size() ? last_first_unstick : end_time));
   // The part of this step inside the event, F_X linear across the step as in shear_at.
   const double from = std::max(step_start, current_.onset_time);
   if (end_time > from) {
@@ -65,6 +76,10 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
   if (!ended) return false;
   finish(end_time, u, shear_at(end_time));
   return true;
+}
+
+void SlipEventDetector::notePeak(double shear_force) {
+  if (std::abs(shear_force) > std::abs(current_.peak_shear_force)) current_.peak_shear_force = shear_force;
 }
 
 void SlipEventDetector::finish(double end_time, const Vector& u, double end_shear_force) {

@@ -83,6 +83,7 @@ friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>
   msg.onset_shear_force = event.onset_shear_force;
   msg.onset_normal_force = event.onset_normal_force;
   msg.end_shear_force = event.end_shear_force;
+  msg.peak_shear_force = event.peak_shear_force;
   msg.mean_shear_force = event.mean_shear_force;
   msg.mean_normal_force = event.mean_normal_force;
   msg.nucleation_position = event.nucleation_position;
@@ -111,6 +112,7 @@ SlipEvent fromMsg(const friction_msgs::SlipEvent& msg) {
   event.onset_shear_force = msg.onset_shear_force;
   event.onset_normal_force = msg.onset_normal_force;
   event.end_shear_force = msg.end_shear_force;
+  event.peak_shear_force = msg.peak_shear_force;
   event.mean_shear_force = msg.mean_shear_force;
   event.mean_normal_force = msg.mean_normal_force;
   event.nucleation_position = msg.nucleation_position;
