@@ -292,6 +292,21 @@ TEST(HardCases, WeakeningLengthShorterThanASpacingIsWarnedWithItsCohesiveZone) {
   EXPECT_NE(sceneWarnings(scene)[0].find("as amontons_coulomb does"), std::string::npos);
 }
 
+TEST(SceneWarnings, APushingHeightBetweenLatticeRowsNamesTheRowPushed) {
+  Scene scene;  // pmma_2d: rows 2.5 mm apart
+  scene.pusher.height = 0.0062;
+  ASSERT_EQ(sceneWarnings(scene).size(), 1u);
+  EXPECT_NE(sceneWarnings(scene)[0].find("pusher.height: 0.0062 m lies between lattice rows (0.0025 m apart); the "
+                                         "pusher acts on the nearest, at 0.005 m"),
+            std::string::npos)
+      << sceneWarnings(scene)[0];
+  scene.pusher.height = 0.0075;  // row 3
+  EXPECT_TRUE(sceneWarnings(scene).empty());
+  scene.model = ModelKind::Chain1D;  // the chain takes h as given (its torque term)
+  scene.pusher.height = 0.0062;
+  EXPECT_TRUE(sceneWarnings(scene).empty());
+}
+
 TEST(HardCases, LargeLatticeTakesAFewSteps) {
   Scene scene = testing::coarseSliderScene();
   scene.lattice.nodes_x = 449;

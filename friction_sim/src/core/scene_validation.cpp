@@ -214,6 +214,17 @@ std::vector<std::string> sceneWarnings(const Scene& s) {
   }
   const double spacing = s.model == ModelKind::Lattice2D ? s.geometry.length / std::max(s.lattice.nodes_x - 1, 1)
                                                          : s.geometry.length / std::max(s.chain.blocks - 1, 1);
+  if (s.model == ModelKind::Lattice2D && !s.pusher.hasBand()) {
+    // The lattice pushes a node, not a height: the user should know which row their h became.
+    const double row_height = std::round(s.pusher.height / spacing) * spacing;
+    if (std::abs(row_height - s.pusher.height) > 1e-6 * spacing) {
+      std::ostringstream text;
+      text.precision(4);
+      text << "pusher.height: " << s.pusher.height << " m lies between lattice rows (" << spacing
+           << " m apart); the pusher acts on the nearest, at " << row_height << " m";
+      warnings.push_back(text.str());
+    }
+  }
   if (s.friction.law == FrictionLawKind::SlipWeakening && s.friction.weakening_length > 0.0 &&
       s.friction.weakening_length < spacing) {
     // What the lattice must resolve is the cohesive zone, where the friction weakens, not ξ_µ itself: an
