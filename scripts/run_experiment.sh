@@ -12,7 +12,8 @@ source "$here/scripts/ros_env.sh"
 out="$RIG_ROOT/results/experiment"
 mkdir -p "$out"
 # Nothing of an earlier run may pass for this one's if this run fails.
-rm -f "$out"/{run.bag,events.csv,loading_curve.png,precursors.png,slip_map.png,scene.yaml}
+outputs=(run.bag loading_curve.png precursors.png slip_map.png events.csv scene.yaml)
+rm -f "${outputs[@]/#/$out/}"
 # roslaunch's chatter is filtered out (grep's status is not the rig's; rig_launch's is). The filter
 # ignores Ctrl-C and reads on while rig_launch stops the rig: roslaunch must not lose its output midway.
 launch_statuses=(0 0)
@@ -27,4 +28,4 @@ esac
 [ -f "$out/run.bag" ] || { echo "run_experiment: no bag was written" >&2; exit 1; }
 set +u; source "$RIG_WS/devel/setup.bash"; set -u
 /usr/bin/python3 "$RIG_ROOT/friction_sim/scripts/rig_report" "$out/run.bag" --out "$out"
-echo "results in $out: run.bag, loading_curve.png, precursors.png, slip_map.png, events.csv, scene.yaml"
+echo "results in $out: ${outputs[*]}"

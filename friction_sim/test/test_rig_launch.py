@@ -88,27 +88,29 @@ def launch(*args, cwd=None):
 
 
 class RigLaunchStatusTest(unittest.TestCase):
-    def test_a_refused_scene_fails_the_launch_and_names_the_simulator(self):
-        status, output = launch("overrides:=pusher.height=1", "analysis:=false")
+    def assert_launch_fails(self, args, *said):
+        """The launch with `args` (and no detector) exits 1 and its output holds each of `said`."""
+        status, output = launch(*args, "analysis:=false")
         self.assertEqual(status, 1, output)
-        self.assertIn("/rig/simulator: scene refused", output)
-        self.assertIn("pusher.height: value 1 is not allowed", output)
-        self.assertIn("rig_launch: failed: rig_simulator (exit code 2)", output)
+        for text in said:
+            self.assertIn(text, output)
+        return output
+
+    def test_a_refused_scene_fails_the_launch_and_names_the_simulator(self):
+        self.assert_launch_fails(["overrides:=pusher.height=1"], "/rig/simulator: scene refused",
+                                 "pusher.height: value 1 is not allowed",
+                                 "rig_launch: failed: rig_simulator (exit code 2)")
 
     def test_a_refused_protocol_fails_the_launch_and_names_the_controller(self):
-        status, output = launch("protocol:=/nonexistent/protocol.yaml", "analysis:=false")
-        self.assertEqual(status, 1, output)
-        self.assertIn("/rig/controller: protocol refused", output)
         # The controller aborts the simulator's run: the simulator's own status tells, whatever the
         # order in which roslaunch sees the two nodes end.
-        self.assertIn("rig_simulator (exit code 4)", output)
-        self.assertIn("aborted by the abort service", output)
+        self.assert_launch_fails(["protocol:=/nonexistent/protocol.yaml"], "/rig/controller: protocol refused",
+                                 "rig_simulator (exit code 4)", "aborted by the abort service")
 
     def test_a_bag_that_cannot_be_written_is_refused_before_the_run(self):
-        status, output = launch("record:=true", "bag:=/nonexistent/dir/run.bag", "analysis:=false")
-        self.assertEqual(status, 1, output)
-        self.assertIn("~bag: value '/nonexistent/dir/run.bag' cannot be written", output)
-        self.assertIn("rig_launch: failed: rig_simulator (exit code 2)", output)
+        output = self.assert_launch_fails(["record:=true", "bag:=/nonexistent/dir/run.bag"],
+                                          "~bag: value '/nonexistent/dir/run.bag' cannot be written",
+                                          "rig_launch: failed: rig_simulator (exit code 2)")
         self.assertNotIn("slip events:", output)
 
     def test_a_crashed_simulator_fails_the_launch(self):

@@ -12,6 +12,10 @@
 
 namespace friction {
 
+/// The row a pusher at `height` (m) above the interface acts on: the nearest of `rows` rows `spacing`
+/// (m) apart.
+int nearestRow(double height, double spacing, int rows);
+
 class Lattice2D : public Model {
  public:
   explicit Lattice2D(const Scene& scene);

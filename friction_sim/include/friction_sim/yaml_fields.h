@@ -27,9 +27,13 @@ class ConfigError : public std::runtime_error {
   std::vector<std::string> problems_;
 };
 
+/// A refused value as refusals write it: ten digits, and NaN as "nan" whatever its sign bit, which the
+/// sender's arithmetic decides ("-nan" reads as a value).
+std::string refusedValueText(double value);
+
 /// Appends "field: value V is not allowed; allowed: A" to `problems` unless `ok`: the one form of the
 /// refusals of a scene's, a protocol's and a node's settings (a command's refusal says what it asked
-/// for in its own words). V with ten digits; NaN as "nan", whatever its sign bit.
+/// for in its own words). V as refusedValueText writes it.
 void requireSetting(bool ok, const std::string& field, double value, const std::string& allowed,
                     std::vector<std::string>& problems);
 

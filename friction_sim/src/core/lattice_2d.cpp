@@ -8,6 +8,10 @@
 
 namespace friction {
 
+int nearestRow(double height, double spacing, int rows) {
+  return std::clamp(static_cast<int>(std::lround(height / spacing)), 0, rows - 1);
+}
+
 namespace {
 std::vector<int> pushedRowsOf(const PusherSpec& pusher, double spacing, int nz) {
   std::vector<int> rows;
@@ -17,7 +21,7 @@ std::vector<int> pushedRowsOf(const PusherSpec& pusher, double spacing, int nz) 
       if (z >= pusher.band_min - 1e-9 * spacing && z <= pusher.band_max + 1e-9 * spacing) rows.push_back(j);
     }
   } else {
-    rows.push_back(std::clamp(static_cast<int>(std::lround(pusher.height / spacing)), 0, nz - 1));
+    rows.push_back(nearestRow(pusher.height, spacing, nz));
   }
   return rows;
 }

@@ -1,6 +1,5 @@
 #include "friction_sim/loading_protocol.h"
 
-#include <algorithm>
 #include <cmath>
 
 #include "friction_sim/yaml_fields.h"
@@ -20,8 +19,13 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
   std::vector<std::string> problems;
   const YAML::Node root = loadMapping(yaml_text, "protocol", source);
   YamlFieldReader reader(root, problems);
+  // A step whose action was refused has no rules to check its other keys by: they would blame fields
+  // the user never wrote.
+  std::vector<bool> action_refused;
   reader.list("steps", protocol.steps, [&](ProtocolStep& step) {
+    const std::size_t problems_before = problems.size();
     reader.field("action", step.action);
+    action_refused.push_back(problems.size() > problems_before);
     reader.field("normal_force", step.normal_force);
     reader.field("ramp_time", step.ramp_time);
     reader.field("speed", step.speed);
@@ -41,14 +45,8 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
   };
   for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
     const ProtocolStep& step = protocol.steps[i];
+    if (i < action_refused.size() && action_refused[i]) continue;
     const std::string where = "steps[" + std::to_string(i) + "]";
-    // A step whose action was refused has no rules to check its other keys by: they would blame
-    // fields the user never wrote.
-    const std::string refused_action = where + ".action:";
-    if (std::any_of(problems.begin(), problems.end(),
-                    [&](const std::string& p) { return p.compare(0, refused_action.size(), refused_action) == 0; })) {
-      continue;
-    }
     if (step.action == ProtocolAction::NormalLoad) {
       if (!(step.normal_force > 0.0) || !std::isfinite(step.normal_force)) problem(where + ".normal_force", step.normal_force, "a finite F_Z > 0 N");
       if (!(step.ramp_time >= 0.0) || !std::isfinite(step.ramp_time)) problem(where + ".ramp_time", step.ramp_time, "a finite time >= 0 s");

@@ -189,19 +189,18 @@ ConfigError::ConfigError(const std::string& what_was_refused, std::vector<std::s
       }()),
       problems_(std::move(problems)) {}
 
+std::string refusedValueText(double value) {
+  if (std::isnan(value)) return "nan";
+  std::ostringstream text;
+  text.precision(10);
+  text << value;
+  return text.str();
+}
+
 void requireSetting(bool ok, const std::string& field, double value, const std::string& allowed,
                     std::vector<std::string>& problems) {
   if (ok) return;
-  std::ostringstream text;
-  text.precision(10);
-  text << field << ": value ";
-  if (std::isnan(value)) {
-    text << "nan";
-  } else {
-    text << value;
-  }
-  text << " is not allowed; allowed: " << allowed;
-  problems.push_back(text.str());
+  problems.push_back(field + ": value " + refusedValueText(value) + " is not allowed; allowed: " + allowed);
 }
 
 YAML::Node loadMapping(const std::string& text, const std::string& what, const std::string& source) {

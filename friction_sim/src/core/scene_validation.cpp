@@ -5,6 +5,7 @@
 
 #include "friction_sim/chain_1d.h"
 #include "friction_sim/integrator.h"
+#include "friction_sim/lattice_2d.h"
 #include "friction_sim/scene_io.h"
 
 namespace friction {
@@ -216,7 +217,7 @@ std::vector<std::string> sceneWarnings(const Scene& s) {
                                                          : s.geometry.length / std::max(s.chain.blocks - 1, 1);
   if (s.model == ModelKind::Lattice2D && !s.pusher.hasBand()) {
     // The lattice pushes a node, not a height: the user should know which row their h became.
-    const double row_height = std::round(s.pusher.height / spacing) * spacing;
+    const double row_height = nearestRow(s.pusher.height, spacing, s.lattice.nodes_z) * spacing;
     if (std::abs(row_height - s.pusher.height) > 1e-6 * spacing) {
       std::ostringstream text;
       text.precision(4);

@@ -5,6 +5,8 @@
 #include <limits>
 #include <sstream>
 
+#include "friction_sim/yaml_fields.h"
+
 namespace friction {
 
 Stage::Stage(const StageSpec& spec, double time_step) : spec_(spec), time_step_(time_step) { enterSegment(0); }
@@ -51,17 +53,8 @@ double Stage::timeToNextChange() const {
 std::string Stage::checkCommand(const StageCommand& command) const {
   std::ostringstream reason;
   if (!std::isfinite(command.speed) || !std::isfinite(command.target)) {
-    // NaN as "nan" whatever its sign bit, which the sender's arithmetic decides ("-nan" reads as a value).
-    auto text = [](double value) {
-      std::ostringstream number;
-      if (std::isnan(value)) {
-        number << "nan";
-      } else {
-        number << value;
-      }
-      return number.str();
-    };
-    reason << "speed " << text(command.speed) << " m/s and target " << text(command.target) << " m must be finite";
+    reason << "speed " << refusedValueText(command.speed) << " m/s and target " << refusedValueText(command.target)
+           << " m must be finite";
   } else if (std::abs(command.speed) > spec_.max_speed) {
     reason << "speed " << command.speed << " m/s exceeds the stage's max_speed " << spec_.max_speed << " m/s";
   } else if (command.mode == StageMode::Position && command.speed <= 0.0) {
