@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 #include "friction_sim/results_io.h"
 #include "friction_sim/simulation.h"
@@ -352,6 +353,24 @@ TEST(Determinism, AStopConditionSetDuringTheRunEndsItOnTheSameStepAsTheScenes) {
        {"global_events -1 is not allowed", "time nan s is not allowed", "stage_travel 0 m is not allowed"}) {
     EXPECT_NE(every_problem.find(problem), std::string::npos) << every_problem;
   }
+  // A condition already met would end the run at once: refused, naming what "now" is.
+  bad = later;
+  bad.global_events = 0;
+  bad.time = 0.5 * changed.time();
+  bad.stage_travel = 0.5 * changed.stage().travel();
+  const std::string past = changed.setStopCondition(bad);
+  auto streamed = [](double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+  };
+  EXPECT_NE(past.find("allowed: > " + streamed(changed.time()) + " s, the time now"), std::string::npos) << past;
+  EXPECT_NE(past.find("allowed: > " + streamed(changed.stage().travel()) + " m, the travel now"),
+            std::string::npos)
+      << past;
+  bad = later;
+  EXPECT_EQ(changed.setStopCondition(bad),
+            "global_events 2 is already reached (2 so far); allowed: > 2 (0: not this condition)");
   EXPECT_EQ(changed.scene().stop.global_events, 2);
   EXPECT_TRUE(changed.finished());
 }

@@ -434,11 +434,19 @@ std::string Simulation::setStopCondition(const StopSpec& stop) {
   if (stop.global_events < 0) {
     problem() << "global_events " << stop.global_events << " is not allowed; allowed: >= 0 (0: not this condition)";
   }
-  if (!(stop.time > 0.0)) {
-    problem() << "time " << stop.time << " s is not allowed; allowed: > 0 s (inf: not this condition)";
+  // A condition already met would end the run on the next step: refused, as a caller who means "now"
+  // calls stop.
+  if (stop.global_events > 0 && detector_.globalEventCount() >= stop.global_events) {
+    problem() << "global_events " << stop.global_events << " is already reached (" << detector_.globalEventCount()
+              << " so far); allowed: > " << detector_.globalEventCount() << " (0: not this condition)";
   }
-  if (!(stop.stage_travel > 0.0)) {
-    problem() << "stage_travel " << stop.stage_travel << " m is not allowed; allowed: > 0 m (inf: not this condition)";
+  if (!(stop.time > time_)) {
+    problem() << "time " << stop.time << " s is not allowed; allowed: > " << time_
+              << " s, the time now (inf: not this condition)";
+  }
+  if (!(stop.stage_travel > stage_.travel())) {
+    problem() << "stage_travel " << stop.stage_travel << " m is not allowed; allowed: > "
+              << stage_.travel() << " m, the travel now (inf: not this condition)";
   }
   if (!reason.str().empty()) return reason.str();
   scene_.stop = stop;
