@@ -12,7 +12,7 @@ source "$here/scripts/ros_env.sh"
 out="$RIG_ROOT/results/experiment"
 mkdir -p "$out"
 # Nothing of an earlier run may pass for this one's if this run fails.
-outputs=(run.bag loading_curve.png precursors.png slip_map.png events.csv scene.yaml)
+outputs=(run.bag loading_curve.png precursors.png slip_map.png events.csv scene.yaml stage_commands.csv)
 rm -f "${outputs[@]/#/$out/}"
 # roslaunch's chatter is filtered out (grep's status is not the rig's; rig_launch's is). The filter
 # ignores Ctrl-C and reads on while rig_launch stops the rig: roslaunch must not lose its output midway.
@@ -28,4 +28,6 @@ esac
 [ -f "$out/run.bag" ] || { echo "run_experiment: no bag was written" >&2; exit 1; }
 set +u; source "$RIG_WS/devel/setup.bash"; set -u
 /usr/bin/python3 "$RIG_ROOT/friction_sim/scripts/rig_report" "$out/run.bag" --out "$out"
-echo "results in $out: ${outputs[*]}"
+written=()
+for output in "${outputs[@]}"; do [ -e "$out/$output" ] && written+=("$output"); done
+echo "results in $out: ${written[*]}"  # without the controller, the scene's own program: no commands

@@ -449,18 +449,39 @@ TEST(FullRun, DetectorTakesTheWaveSpeedsFromTheRunsSceneGivenOrRecorded) {
   }
 }
 
-TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
+TEST(FullRun, BagHoldsTheCommandsAsApplied) {
+  // The protocol's schedule, each command at the first step at or after its time; the refused commands
+  // sent while the rig ran are not among them.
   ros::NodeHandle pnh("~");
   std::string scene_path, protocol_path;
   pnh.getParam("scene", scene_path);
   pnh.getParam("protocol", protocol_path);
-  Simulation offline(loadScene(scene_path));
-  const auto schedule = scheduleProtocol(loadProtocol(protocol_path), 0.0, offline.scene().load.normal_force);
+  const Scene scene = loadScene(scene_path);
+  const auto schedule = scheduleProtocol(loadProtocol(protocol_path), 0.0, scene.load.normal_force);
+  const auto applied = readTopic<friction_msgs::StageCommand>(g_bag, "/rig/applied_commands");
+  ASSERT_EQ(applied.size(), schedule.size());
+  for (std::size_t c = 0; c < schedule.size(); ++c) {
+    const TimedCommand recorded = fromMsg(*applied[c]);
+    EXPECT_GE(recorded.time, schedule[c].time - 1e-9);
+    EXPECT_LT(recorded.time, schedule[c].time + scene.integrator.time_step);
+    EXPECT_EQ(recorded.stage.mode, schedule[c].stage.mode);
+    EXPECT_EQ(recorded.stage.speed, schedule[c].stage.speed);
+  }
+}
+
+TEST(FullRun, TheBagAloneRunsTheSameRunOffline) {
+  // The scene and the commands as the bag recorded them, each applied before the step at its stamp, as
+  // the simulator node did (a stamp is the step's time rounded to the nanosecond).
+  const auto scenes = readTopic<std_msgs::String>(g_bag, "/rig/scene");
+  const auto applied = readTopic<friction_msgs::StageCommand>(g_bag, "/rig/applied_commands");
+  ASSERT_EQ(scenes.size(), 1u);
+  ASSERT_FALSE(applied.empty());
+  Simulation offline(parseScene(scenes[0]->data));
   std::size_t next = 0;
   while (offline.globalEventCount() < 2 && offline.time() < 5.0) {
-    // As the simulator node does: commands due by now are applied before the step.
-    for (; next < schedule.size() && schedule[next].time <= offline.time(); ++next) {
-      offline.stage().command(schedule[next].stage);
+    const double step_time = offline.time() + 0.5 * offline.timeStep();
+    for (; next < applied.size() && fromMsg(*applied[next]).time < step_time; ++next) {
+      offline.stage().command(fromMsg(*applied[next]).stage);
     }
     offline.step();
   }

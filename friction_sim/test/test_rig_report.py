@@ -12,7 +12,7 @@ import unittest
 import rosbag
 import rospy
 import rosunit
-from friction_msgs.msg import InterfaceState, SlipEvent
+from friction_msgs.msg import InterfaceState, SlipEvent, StageCommand
 from geometry_msgs.msg import WrenchStamped
 from std_msgs.msg import String
 
@@ -44,6 +44,11 @@ def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=No
                 for topic, msg, stamp in other.read_messages():
                     bag.write(topic, msg, stamp)
         bag.write(namespace + "/scene", String(data=SCENE), rospy.Time(0, 1))
+        drive = StageCommand(mode=StageCommand.VELOCITY, speed=4e-4, target=0.5, normal_force=7.0)
+        bag.write(namespace + "/applied_commands", drive, rospy.Time(0, 2))
+        load = StageCommand(mode=StageCommand.NORMAL_LOAD, normal_force=2500.0)
+        load.header.stamp = rospy.Time.from_sec(0.05)
+        bag.write(namespace + "/applied_commands", load, load.header.stamp)
         for step in range(1, 101):
             stamp = rospy.Time.from_sec(step * 1e-3)
             wrench = WrenchStamped()
@@ -87,6 +92,13 @@ class RigReportTest(unittest.TestCase):
             self.assertTrue(os.path.exists(os.path.join(self.work, figure)), figure)
         with open(os.path.join(self.work, "scene.yaml")) as scene:
             self.assertEqual(scene.read(), SCENE)  # the scene as run, from the bag
+        # The commands as applied, each with the fields its mode uses (a velocity command's target is
+        # not one of them).
+        with open(os.path.join(self.work, "stage_commands.csv")) as handle:
+            self.assertEqual(list(csv.reader(handle)), [
+                ["time_s", "command", "speed_m_s", "target_m", "normal_force_N"],
+                ["0.000000000", "velocity", "0.0004", "", ""],
+                ["0.050000000", "normal_load", "", "", "2500.0"]])
 
     def test_the_detectors_events_on_request(self):
         done = self.report("--events", "detector")

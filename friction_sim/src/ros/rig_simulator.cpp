@@ -130,6 +130,7 @@ void RigSimulator::advertise() {
   events_pub_ = nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   lattice_pub_ = nh_.advertise<friction_msgs::LatticeSnapshot>("lattice", 2);
   stage_pub_ = nh_.advertise<friction_msgs::StageState>("stage_state", 100);
+  applied_commands_pub_ = nh_.advertise<friction_msgs::StageCommand>("applied_commands", 100);
   command_sub_ = nh_.subscribe("stage_command", 1000, &RigSimulator::onCommand, this);
   command_srv_ = nh_.advertiseService("send_command", &RigSimulator::onSendCommand, this);
   pause_srv_ = nh_.advertiseService("pause", &RigSimulator::onPause, this);
@@ -257,7 +258,17 @@ void RigSimulator::applyDueCommands() {
     const std::string reason = command.kind == TimedCommand::Kind::NormalLoad
                                    ? simulation_->setNormalLoad(command.normal_force)
                                    : simulation_->stage().command(command.stage);
-    if (!reason.empty()) ROS_WARN_STREAM("stage command refused: " << reason);
+    if (reason.empty()) {
+      friction_msgs::StageCommand applied = toMsg(command);
+      applied.header.stamp = toStamp(now);
+      applied.header.frame_id = options_.frame_id;
+      applied_commands_pub_.publish(applied);
+      // Unlike a measurement, a command at t = 0 matters: in the bag at its earliest time after the
+      // scene's (1 ns), its stamp kept.
+      if (bag_open_) bag_.write(applied_commands_pub_.getTopic(), std::max(applied.header.stamp, ros::Time(0, 2)), applied);
+    } else {
+      ROS_WARN_STREAM("stage command refused: " << reason);
+    }
     pending_.erase(pending_.begin());
   }
 }

@@ -28,6 +28,9 @@
 //   stage_state (friction_msgs/StageState)
 //   scene (std_msgs/String, latched)               the scene as run, overrides applied, in the scene YAML
 //                                                  format (also the bag's first message)
+//   applied_commands (friction_msgs/StageCommand)  every command as it took effect, stamped with the
+//                                                  simulated time of the step it took effect at: with the
+//                                                  scene, the bag holds what it takes to run it again
 // Subscribed topics:
 //   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time)
 // Services:
@@ -162,7 +165,7 @@ class RigSimulator {
   ros::WallTime running_since_;     ///< when the simulation last began running (unpaused)
   double pace_origin_sim_ = 0.0;
   ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_,
-      scene_pub_;
+      scene_pub_, applied_commands_pub_;
   ros::Subscriber command_sub_;
   ros::ServiceServer command_srv_, pause_srv_, reset_srv_, stop_srv_, abort_srv_, run_end_srv_;
 };
