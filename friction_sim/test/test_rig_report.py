@@ -5,6 +5,7 @@ bag without the rig's load cells is refused with the topics it does hold."""
 import csv
 import os
 import shutil
+import struct
 import subprocess
 import tempfile
 import unittest
@@ -32,10 +33,10 @@ def event(index, onset, shear_ratio, rupture_length, slider_length=0.14):
     return msg
 
 
-def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None):
-    """Load cells and frames for 0.1 s, two events from the simulator and, unless not `detector`, the same
-    two, with the detector's slightly later reading of F_X, from the detector; `also` another rig's
-    namespace with the same."""
+def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None, normal_load_rise=0.0):
+    """Load cells and frames for 0.1 s (F_Z rising by `normal_load_rise` N per ms), two events from the
+    simulator and, unless not `detector`, the same two, with the detector's slightly later reading of F_X,
+    from the detector; `also` another rig's namespace with the same."""
     if also:
         write_bag(path + ".also", also, detector, slider_length)
     with rosbag.Bag(path, "w") as bag:
@@ -53,7 +54,7 @@ def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=No
             stamp = rospy.Time.from_sec(step * 1e-3)
             wrench = WrenchStamped()
             wrench.header.stamp = stamp
-            wrench.wrench.force.x, wrench.wrench.force.z = 4.0 * step, -F_Z
+            wrench.wrench.force.x, wrench.wrench.force.z = 4.0 * step, -(F_Z + normal_load_rise * step)
             bag.write(namespace + "/load_cells", wrench, stamp)
             frame = InterfaceState()
             frame.header.stamp = stamp
@@ -127,6 +128,17 @@ class RigReportTest(unittest.TestCase):
         self.assertIn("holds several rigs; choose one with --ns: /bench/ | /rig/", done.stderr)
         done = self.report("--ns", "rig")
         self.assertEqual(done.returncode, 0, done.stderr)
+
+    def test_a_changing_normal_load_gets_a_panel_of_its_own(self):
+        # The loading curve is 3.6 inches high at 110 dpi, 5 with F_Z's panel below it.
+        def figure_height():
+            with open(os.path.join(self.work, "loading_curve.png"), "rb") as png:
+                return struct.unpack(">II", png.read(24)[16:24])[1]  # IHDR: width, height
+        self.assertEqual(self.report().returncode, 0)
+        self.assertEqual(figure_height(), 396)
+        write_bag(self.bag, normal_load_rise=5.0)
+        self.assertEqual(self.report().returncode, 0)
+        self.assertEqual(figure_height(), 550)
 
     def test_an_unknown_slider_length_gives_no_length_ratio(self):
         # The detector's events on a single block without a scene carry L = 0.
