@@ -28,11 +28,13 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 
 #include "friction_sim/loading_protocol.h"
 #include "friction_sim/ros/conversions.h"
+#include "friction_sim/ros/node_parameters.h"
 #include "friction_sim/scene_io.h"
 #include "friction_sim/simulation.h"
 
@@ -230,6 +232,25 @@ void runControllerThroughAFailedCall(const std::string& protocol) {
       simulator.runController(protocol, "_start_delay:=0", g_seen.failed_call_controller_output);
 }
 
+/// The scene rig.launch ran: the test's ~scene with its ~overrides.
+Scene launchedScene() {
+  ros::NodeHandle pnh("~");
+  std::string scene_path, overrides;
+  pnh.getParam("scene", scene_path);
+  pnh.getParam("overrides", overrides);
+  std::vector<std::string> problems;
+  const auto parsed = parseOverrides(overrides, problems);
+  EXPECT_TRUE(problems.empty());
+  return loadScene(scene_path, parsed);
+}
+
+/// The commands of the test's ~protocol, as its controller schedules them from t = 0.
+std::vector<TimedCommand> launchedSchedule(const Scene& scene) {
+  std::string protocol_path;
+  ros::NodeHandle("~").getParam("protocol", protocol_path);
+  return scheduleProtocol(loadProtocol(protocol_path), 0.0, scene.load.normal_force);
+}
+
 bool bagReadable(const std::string& path) {
   try {
     rosbag::Bag bag(path, rosbag::bagmode::Read);
@@ -404,10 +425,8 @@ TEST(FullRun, BagHoldsTheSceneAsRunFirst) {
   ASSERT_TRUE(bagReadable(g_bag)) << g_bag;
   const auto scenes = readTopic<std_msgs::String>(g_bag, "/rig/scene");
   ASSERT_EQ(scenes.size(), 1u);
-  std::string scene_path;
-  ros::NodeHandle("~").getParam("scene", scene_path);
-  // The recorded text reads back as the scene the launch named, field for field.
-  EXPECT_EQ(sceneToYaml(parseScene(scenes[0]->data)), sceneToYaml(loadScene(scene_path)));
+  // The recorded text reads back as the scene the launch named, its overrides applied, field for field.
+  EXPECT_EQ(sceneToYaml(parseScene(scenes[0]->data)), sceneToYaml(launchedScene()));
   rosbag::Bag bag(g_bag);
   rosbag::View everything(bag);
   ASSERT_GT(everything.size(), 0u);
@@ -452,12 +471,8 @@ TEST(FullRun, DetectorTakesTheWaveSpeedsFromTheRunsSceneGivenOrRecorded) {
 TEST(FullRun, BagHoldsTheCommandsAsApplied) {
   // The protocol's schedule, each command at the first step at or after its time; the refused commands
   // sent while the rig ran are not among them.
-  ros::NodeHandle pnh("~");
-  std::string scene_path, protocol_path;
-  pnh.getParam("scene", scene_path);
-  pnh.getParam("protocol", protocol_path);
-  const Scene scene = loadScene(scene_path);
-  const auto schedule = scheduleProtocol(loadProtocol(protocol_path), 0.0, scene.load.normal_force);
+  const Scene scene = launchedScene();
+  const auto schedule = launchedSchedule(scene);
   const auto applied = readTopic<friction_msgs::StageCommand>(g_bag, "/rig/applied_commands");
   ASSERT_EQ(applied.size(), schedule.size());
   for (std::size_t c = 0; c < schedule.size(); ++c) {
@@ -469,22 +484,20 @@ TEST(FullRun, BagHoldsTheCommandsAsApplied) {
   }
 }
 
-TEST(FullRun, TheBagAloneRunsTheSameRunOffline) {
-  // The scene and the commands as the bag recorded them, each applied before the step at its stamp, as
-  // the simulator node did (a stamp is the step's time rounded to the nanosecond).
-  const auto scenes = readTopic<std_msgs::String>(g_bag, "/rig/scene");
-  const auto applied = readTopic<friction_msgs::StageCommand>(g_bag, "/rig/applied_commands");
-  ASSERT_EQ(scenes.size(), 1u);
-  ASSERT_FALSE(applied.empty());
-  Simulation offline(parseScene(scenes[0]->data));
+TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
+  // As the simulator node runs: the commands due by now applied before the step, and a fast-forward
+  // jump cut only where the next command is due (the instruments are interpolated across it).
+  Simulation offline(launchedScene());
+  ASSERT_TRUE(offline.scene().integrator.fast_forward);
+  const auto schedule = launchedSchedule(offline.scene());
   std::size_t next = 0;
   while (offline.globalEventCount() < 2 && offline.time() < 5.0) {
-    const double step_time = offline.time() + 0.5 * offline.timeStep();
-    for (; next < applied.size() && fromMsg(*applied[next]).time < step_time; ++next) {
-      offline.stage().command(fromMsg(*applied[next]).stage);
+    for (; next < schedule.size() && schedule[next].time <= offline.time(); ++next) {
+      offline.stage().command(schedule[next].stage);
     }
-    offline.step();
+    offline.advance(next < schedule.size() ? schedule[next].time : std::numeric_limits<double>::infinity());
   }
+  EXPECT_GT(offline.jumps(), 0);
   // The simulator ends the run itself on the step of the protocol's end (set_run_end), however late the
   // controller hears of it: the live run holds the same events and ends at the same step.
   ASSERT_EQ(g_seen.events.size(), offline.events().size());

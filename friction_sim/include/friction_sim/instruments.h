@@ -60,6 +60,13 @@ struct LatticeSnapshot {
 /// Strain gauges at time t between two profiles at the same positions, linearly.
 GaugeProfile interpolate(const GaugeProfile& a, const GaugeProfile& b, double t);
 
+/// The camera's frame at time t between two frames of a fast-forward jump: slip, forces and stresses
+/// linearly; the contact states are `a`'s until `b`'s time (a jump ends where a state changes).
+InterfaceFrame interpolate(const InterfaceFrame& a, const InterfaceFrame& b, double t);
+
+/// The slider's nodes at time t between two snapshots of a fast-forward jump, as the frames are.
+LatticeSnapshot interpolate(const LatticeSnapshot& a, const LatticeSnapshot& b, double t);
+
 /// Energy budget since the loaded equilibrium: work in = Δelastic + Δkinetic + dissipated.
 struct EnergyBudget {
   double work_in = 0.0;               ///< J, by the pusher's stage and the top load

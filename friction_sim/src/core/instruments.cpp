@@ -11,27 +11,65 @@ double EnergyBudget::relativeResidual() const {
   return residual() / scale;
 }
 
+namespace {
+/// The weight of `b` at time t between a's and b's times (b's alone if they coincide).
+double weightAt(double a_time, double b_time, double t) { return b_time > a_time ? (t - a_time) / (b_time - a_time) : 1.0; }
+
+double blend(double from, double to, double w) { return from + w * (to - from); }
+
+/// `to` becomes from + w·(to − from), entry by entry.
+void blend(const std::vector<double>& from, std::vector<double>& to, double w) {
+  for (std::size_t i = 0; i < to.size() && i < from.size(); ++i) to[i] = blend(from[i], to[i], w);
+}
+
+void blend(const GaugeStresses& from, GaugeStresses& to, double w) {
+  blend(from.sigma_xx, to.sigma_xx, w);
+  blend(from.sigma_zz, to.sigma_zz, w);
+  blend(from.tau_xz, to.tau_xz, w);
+}
+}  // namespace
+
 LoadCellReading interpolate(const LoadCellReading& a, const LoadCellReading& b, double t) {
-  const double w = b.time > a.time ? (t - a.time) / (b.time - a.time) : 1.0;
+  const double w = weightAt(a.time, b.time, t);
   LoadCellReading out = b;
   out.time = t;
-  out.stage_position = a.stage_position + w * (b.stage_position - a.stage_position);
-  out.shear_force = a.shear_force + w * (b.shear_force - a.shear_force);
-  out.normal_force = a.normal_force + w * (b.normal_force - a.normal_force);
-  out.interface_normal_sum = a.interface_normal_sum + w * (b.interface_normal_sum - a.interface_normal_sum);
+  out.stage_position = blend(a.stage_position, b.stage_position, w);
+  out.shear_force = blend(a.shear_force, b.shear_force, w);
+  out.normal_force = blend(a.normal_force, b.normal_force, w);
+  out.interface_normal_sum = blend(a.interface_normal_sum, b.interface_normal_sum, w);
   return out;
 }
 
 GaugeProfile interpolate(const GaugeProfile& a, const GaugeProfile& b, double t) {
-  const double w = b.time > a.time ? (t - a.time) / (b.time - a.time) : 1.0;
   GaugeProfile out = b;
   out.time = t;
-  auto blend = [w](const std::vector<double>& from, std::vector<double>& to) {
-    for (std::size_t i = 0; i < to.size() && i < from.size(); ++i) to[i] = from[i] + w * (to[i] - from[i]);
-  };
-  blend(a.stress.sigma_xx, out.stress.sigma_xx);
-  blend(a.stress.sigma_zz, out.stress.sigma_zz);
-  blend(a.stress.tau_xz, out.stress.tau_xz);
+  blend(a.stress, out.stress, weightAt(a.time, b.time, t));
+  return out;
+}
+
+InterfaceFrame interpolate(const InterfaceFrame& a, const InterfaceFrame& b, double t) {
+  const double w = weightAt(a.time, b.time, t);
+  InterfaceFrame out = b;
+  out.time = t;
+  if (t < b.time) out.state = a.state;
+  for (auto field : {&InterfaceFrame::slip_velocity, &InterfaceFrame::slip, &InterfaceFrame::normal_force,
+                     &InterfaceFrame::friction_force, &InterfaceFrame::normal_stress, &InterfaceFrame::shear_stress}) {
+    blend(a.*field, out.*field, w);
+  }
+  return out;
+}
+
+LatticeSnapshot interpolate(const LatticeSnapshot& a, const LatticeSnapshot& b, double t) {
+  const double w = weightAt(a.time, b.time, t);
+  LatticeSnapshot out = b;
+  out.time = t;
+  if (t < b.time) out.interface_state = a.interface_state;
+  blend(a.x, out.x, w);
+  blend(a.z, out.z, w);
+  blend(a.speed, out.speed, w);
+  blend(a.stress, out.stress, w);
+  out.stage_position = blend(a.stage_position, b.stage_position, w);
+  out.normal_force = blend(a.normal_force, b.normal_force, w);
   return out;
 }
 

@@ -112,7 +112,15 @@ void RigSimulator::startSimulation() {
     interface_positions_.push_back(simulation_->model().interfacePosition(node));
   }
   pending_.clear();
-  next_load_cells_ = next_gauges_ = next_frame_ = next_stage_state_ = next_clock_ = next_lattice_ = 0.0;
+  // Nothing is measured at t = 0 (a bag cannot hold a zero stamp): each stream starts one period in,
+  // also when a fast-forward jump leaves t = 0 (a camera frame at 0, published and not recorded, would
+  // leave a gap in the bag's frame_index).
+  next_load_cells_ = 1.0 / options_.load_cell_rate;
+  next_gauges_ = 1.0 / options_.gauge_rate;
+  next_frame_ = 1.0 / options_.interface_idle_rate;
+  next_stage_state_ = 1.0 / options_.stage_state_rate;
+  next_clock_ = 1.0 / options_.clock_rate;
+  next_lattice_ = 1.0 / options_.lattice_rate;
   next_snapshot_ = ros::WallTime::now();
   reset_requested_ = false;
   run_end_set_ = false;
@@ -189,21 +197,36 @@ void RigSimulator::publishStageState(const LoadCellReading& cells) {
   emit(stage_pub_, "stage_state", msg);
 }
 
-void RigSimulator::publishAcrossJump(const LoadCellReading& cells_before, const GaugeProfile& gauges_before) {
+RigSimulator::Readings RigSimulator::readings() const {
+  Readings now;
+  now.cells = simulation_->loadCells();
+  if (scene_.model == ModelKind::Lattice2D) now.gauges = simulation_->gaugeProfile();
+  now.frame = simulation_->interfaceFrame();
+  now.lattice = simulation_->snapshot();
+  return now;
+}
+
+void RigSimulator::publishAcrossJump(const Readings& before) {
   const double t = simulation_->time();
-  const LoadCellReading cells_after = simulation_->loadCells();
+  const Readings after = readings();
   const bool gauges = scene_.model == ModelKind::Lattice2D;
-  const GaugeProfile gauges_after = gauges ? simulation_->gaugeProfile() : GaugeProfile{};
   // Each stream on its own grid, in time order within the stream.
   for (; next_clock_ <= t; next_clock_ += 1.0 / options_.clock_rate) publishClock(next_clock_);
   for (; next_load_cells_ <= t; next_load_cells_ += 1.0 / options_.load_cell_rate) {
-    emit(load_cells_pub_, "load_cells", toMsg(interpolate(cells_before, cells_after, next_load_cells_), options_.frame_id));
+    emit(load_cells_pub_, "load_cells", toMsg(interpolate(before.cells, after.cells, next_load_cells_), options_.frame_id));
   }
   for (; gauges && next_gauges_ <= t; next_gauges_ += 1.0 / options_.gauge_rate) {
-    emit(gauges_pub_, "strain_gauges", toMsg(interpolate(gauges_before, gauges_after, next_gauges_), options_.frame_id));
+    emit(gauges_pub_, "strain_gauges", toMsg(interpolate(before.gauges, after.gauges, next_gauges_), options_.frame_id));
+  }
+  // The whole interface sticks along a jump: the camera's idle rate.
+  for (; next_frame_ <= t; next_frame_ += 1.0 / options_.interface_idle_rate) {
+    emit(interface_pub_, "interface", toMsg(interpolate(before.frame, after.frame, next_frame_), frame_index_++, options_.frame_id));
+  }
+  for (; next_lattice_ <= t; next_lattice_ += 1.0 / options_.lattice_rate) {
+    emit(lattice_pub_, "lattice", toMsg(interpolate(before.lattice, after.lattice, next_lattice_), options_.frame_id));
   }
   for (; next_stage_state_ <= t; next_stage_state_ += 1.0 / options_.stage_state_rate) {
-    publishStageState(interpolate(cells_before, cells_after, next_stage_state_));
+    publishStageState(interpolate(before.cells, after.cells, next_stage_state_));
   }
 }
 
@@ -368,18 +391,20 @@ void RigSimulator::run() {
       continue;
     }
     applyDueCommands();
-    // A fast-forward jump stops at the next interface frame and the next command; the other
-    // instruments are interpolated across it.
-    double until = std::min(next_frame_, next_lattice_);
-    if (!pending_.empty()) until = std::min(until, pending_.begin()->first);
+    // A fast-forward jump stops at the next command, which changes the stage's motion. Run as fast as
+    // possible it stops nowhere else and the instruments are interpolated across it: the jumps follow
+    // the curved equilibrium path in straight pieces, so where they were cut would change the run, and
+    // the offline runner's run of the same scene and commands is this one, step for step. Paced, it
+    // also stops at each interface frame, so that a watcher sees the slider move and a command sent
+    // "now" takes effect within a frame; the events then agree with the unpaced run's to fast-forward's
+    // own error.
+    double until = pending_.empty() ? std::numeric_limits<double>::infinity() : pending_.begin()->first;
+    if (options_.real_time_factor > 0.0) until = std::min(until, next_frame_);
     const long long jumps = simulation_->jumps();
     // The readings before a possible jump, to interpolate across it; not needed for a plain step.
-    const bool may_jump = simulation_->mayJump();
-    const LoadCellReading cells_before = may_jump ? simulation_->loadCells() : LoadCellReading{};
-    const GaugeProfile gauges_before =
-        may_jump && scene_.model == ModelKind::Lattice2D ? simulation_->gaugeProfile() : GaugeProfile{};
+    const Readings before = simulation_->mayJump() ? readings() : Readings{};
     simulation_->advance(until);
-    if (simulation_->jumps() != jumps) publishAcrossJump(cells_before, gauges_before);
+    if (simulation_->jumps() != jumps) publishAcrossJump(before);
     publishInstruments();
     if ((options_.stop_at_scene_end || run_end_set_) && simulation_->finished()) {
       end_reason = simulation_->stopReason();

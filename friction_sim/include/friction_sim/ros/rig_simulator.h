@@ -31,6 +31,10 @@
 //   applied_commands (friction_msgs/StageCommand)  every command as it took effect, stamped with the
 //                                                  simulated time of the step it took effect at: with the
 //                                                  scene, the bag holds what it takes to run it again
+// Across a fast-forward jump each stream is interpolated on its own grid (the camera at
+// interface_idle_rate): the jump is cut only where a command is due, so that the run is the offline
+// runner's, step for step; paced (real_time_factor > 0) also at every interface frame, so that a watcher
+// sees the slider move and a command sent "now" acts within a frame.
 // Subscribed topics:
 //   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time)
 // Services:
@@ -118,9 +122,17 @@ class RigSimulator {
   void advertise();
   void startSimulation();
   void publishInstruments();
-  /// After a fast-forward jump: the load cells, gauges, stage state and clock at every publication time
-  /// the jump passed, interpolated (the statics are affine in time along a jump).
-  void publishAcrossJump(const LoadCellReading& cells_before, const GaugeProfile& gauges_before);
+  /// Every instrument's reading at one instant.
+  struct Readings {
+    LoadCellReading cells;
+    GaugeProfile gauges;  ///< empty for the chain
+    InterfaceFrame frame;
+    LatticeSnapshot lattice;
+  };
+  Readings readings() const;
+  /// After a fast-forward jump: every instrument's reading at every publication time the jump passed,
+  /// interpolated from `before` the jump and after it (along a jump the statics are nearly affine in time).
+  void publishAcrossJump(const Readings& before);
   void publishClock(double time);
   void publishStageState(const LoadCellReading& cells);
   void applyDueCommands();
