@@ -79,6 +79,23 @@ TEST(FastForward, InstrumentsInterpolatedAcrossAJumpReadWhatAJumpCutThereGives) 
   EXPECT_EQ(lattice.interface_state, lattice_cut.interface_state);
 }
 
+TEST(FastForward, AHoldCommandedWhileAThresholdIsApproachedJumpsAgain) {
+  // Near a threshold the dynamics takes the approach over; a hold commanded then never brings the
+  // crossing, and the slider, at rest where it stands, jumps again (it had stepped dynamically for the
+  // whole hold: 54 713 steps in 20 ms, found by a review).
+  Simulation simulation(testing::coarseSliderScene(true));
+  while (simulation.mayJump() || simulation.jumps() == 0) simulation.advance(1.0);
+  ASSERT_TRUE(simulation.quasiStatic());
+  ASSERT_TRUE(simulation.events().empty());
+  simulation.stage().command(StageCommand{StageMode::Hold, 0.0, 0.0});
+  const long long steps = simulation.steps(), jumps = simulation.jumps();
+  const double hold_end = simulation.time() + 0.02;
+  while (simulation.time() < hold_end) simulation.advance(hold_end);
+  EXPECT_GT(simulation.jumps(), jumps);
+  EXPECT_LT(simulation.steps() - steps, 10);
+  EXPECT_TRUE(simulation.events().empty());
+}
+
 TEST(FastForward, AStageTravelLimitEndsTheRunWithinAStepOfIt) {
   // 20 µm of travel comes long before the first precursor (about 55 µm): a jump toward that threshold
   // would pass the limit by micrometres if it were cut only at the time limit.

@@ -47,7 +47,7 @@ class Simulation : public Dynamics {
   /// True while the slider sits in static equilibrium with no node sliding (fast-forward can jump).
   bool quasiStatic() const { return quasi_static_; }
   /// True if the next `advance` may be a fast-forward jump.
-  bool mayJump() const { return quasi_static_ && !approaching_threshold_ && !stageTooFast(); }
+  bool mayJump() const { return quasi_static_ && !approachingThreshold() && !stageTooFast(); }
   /// Fast-forward jumps taken, and simulated time (s) they covered.
   long long jumps() const { return jumps_; }
   double jumpedTime() const { return jumped_time_; }
@@ -206,6 +206,11 @@ class Simulation : public Dynamics {
   std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
   bool quasi_static_ = false;
   bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
+  double approach_velocity_ = 0.0;      ///< m/s, the stage's velocity then: the crossing is that motion's
+  /// The dynamics takes a threshold's approach over while the stage keeps the velocity that brings the
+  /// crossing; another motion (a hold, a reversal: a command or a segment of the program) may never
+  /// bring it, and jumps again.
+  bool approachingThreshold() const { return approaching_threshold_ && stage_.velocity() == approach_velocity_; }
   /// m/s, 10⁻³ of the bar-wave speed √(E/ρ): MODEL.md §5's fast-forward rests on a stage far slower than
   /// the waves (the lab's is 10⁻⁸ of it). A stage step that moves faster leaves the static path.
   double quasi_static_stage_speed_;

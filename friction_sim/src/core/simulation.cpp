@@ -118,6 +118,7 @@ bool Simulation::fastForward(double until) {
     // A crossing that keeps receding (met tangentially) is left to the dynamics.
     if (jump == kMaxApproachJumps) {
       approaching_threshold_ = toward_threshold;
+      approach_velocity_ = stage_.velocity();
       break;
     }
   }
@@ -192,6 +193,7 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   }
   if (!(jump > dt_)) {
     approaching_threshold_ = stops_at_threshold;
+    approach_velocity_ = speed;
     return false;
   }
   if (stops_at_threshold) jump *= kApproachShare;
