@@ -59,6 +59,9 @@ class ContactInterface {
   /// re-stick; if its velocity turned in that step, it slides the other way from then on. Returns true if
   /// any node's friction changed (it re-stuck or turned).
   bool finishStep(Vector& u, Vector& v, double dt);
+  /// The last finishStep's slip changed sliding coefficients (a slip-dependent law): the friction of the
+  /// step's end must be applied again (reapplyFriction) before the next step uses it.
+  bool slipChangedCoefficients() const { return slip_changed_coefficients_; }
   /// After the last force evaluation of a step of length dt and its applyFriction at these displacements
   /// (the stuck nodes' loads are its friction forces): loss and return of
   /// contact, unsticking. A node that crossed its threshold at a fraction s of the step is given the
@@ -136,6 +139,7 @@ class ContactInterface {
 
   std::unique_ptr<FrictionLaw> law_;
   bool uniform_law_;  ///< law_->uniform(), asked once
+  bool slip_changed_coefficients_ = false;
   std::vector<int> dofs_;
   int first_dof_;
   double k_t_;

@@ -313,7 +313,13 @@ void Simulation::accountStep(const StepStart& start, double end_shear_force, dou
 }
 
 void Simulation::settleInterface() {
-  if (contact_.finishStep(u_, v_, dt_)) power_ = acceleration(u_, v_, time_, a_);
+  if (contact_.finishStep(u_, v_, dt_)) {
+    power_ = acceleration(u_, v_, time_, a_);
+  } else if (contact_.slipChangedCoefficients()) {
+    // The step's force was evaluated with the coefficients of the slip before it; the next step starts
+    // from those of the slip after it (a whole step's lag otherwise).
+    reapplyFriction();
+  }
   if (contact_.updateStates(u_, v_, dt_, node_mass_)) reapplyFriction();
 }
 
