@@ -47,6 +47,7 @@ class FrameEventDetector {
   std::optional<InterfaceFrame> last_stuck_frame_;
   bool in_event_ = false;
   SlipEvent current_;
+  ContactDuringEvent in_contact_;  ///< of the current event
   std::deque<SlipEvent> ended_;  ///< waiting for their load cells
 };
 

@@ -2,6 +2,7 @@
 // and ends when all are stuck again. Detected from the contact interface after every step.
 #pragma once
 
+#include <cstddef>
 #include <limits>
 #include <vector>
 
@@ -38,12 +39,36 @@ struct SlipEvent {
   double slip_min_x = 0.0;          ///< m, smallest x of a node that slipped
   double slip_max_x = 0.0;          ///< m, largest x of a node that slipped
   double rupture_length = 0.0;      ///< m, L_p = slip_max_x − slip_min_x (L for one node: measureExtent)
-  bool global = false;              ///< every interface node slipped
+  bool global = false;              ///< every interface node in contact with the track slipped (measureExtent)
   std::vector<double> node_slip;    ///< m, per interface node, displacement during the event
   std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
   std::vector<double> front_speed;  ///< m/s, v_c per node from the first-unstick times; NaN where undefined
   double median_front_speed = std::numeric_limits<double>::quiet_NaN();  ///< m/s, summarizeFrontSpeeds; NaN: none
   int front_fits_left_out = 0;      ///< fits left out of that median (summarizeFrontSpeeds)
+};
+
+/// The nodes that touched the track during an event so far: every one while none is lifted, which is
+/// the rule and is checked in constant time.
+class ContactDuringEvent {
+ public:
+  /// A new event on `nodes` interface nodes.
+  void start(std::size_t nodes);
+  /// Notes the states now (ContactState values); `detached` of them lifted.
+  template <class StateOf>
+  void note(std::size_t detached, StateOf state_of) {
+    if (count_ == touched_.size()) return;
+    for (std::size_t node = 0; node < touched_.size(); ++node) {
+      if (!touched_[node] && (detached == 0 || state_of(node) != ContactState::Detached)) {
+        touched_[node] = 1;
+        ++count_;
+      }
+    }
+  }
+  std::size_t count() const { return count_; }
+
+ private:
+  std::vector<char> touched_;
+  std::size_t count_ = 0;
 };
 
 class SlipEventDetector {
@@ -78,6 +103,7 @@ class SlipEventDetector {
   SlipEvent current_;
   void notePeak(double shear_force);
   std::size_t slipped_ = 0;      ///< nodes of the current event that have slipped so far
+  ContactDuringEvent in_contact_;  ///< of the current event
   double shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the current event so far
   double normal_impulse_ = 0.0;  ///< N·s, ∫F_Z dt
   std::vector<double> onset_u_;
@@ -136,7 +162,11 @@ void measureFronts(SlipEvent& event, const std::vector<double>& positions, int f
 
 /// Sets slip_min_x, slip_max_x, rupture_length and global from the nodes that slipped (those with a
 /// first-unstick time) at `positions` (m). L_p spans them; a one-node interface, the single block, is the
-/// whole slider: L_p = `slider_length` (m) once it slips.
-void measureExtent(SlipEvent& event, const std::vector<double>& positions, double slider_length);
+/// whole slider: L_p = `slider_length` (m) once it slips. The event is global when every node that touched
+/// the track during it slipped (`nodes_in_contact` of them): a node lifted throughout cannot slip, and a
+/// slider that slides as a whole with its trailing corner lifted does so globally.
+void measureExtent(SlipEvent& event, const std::vector<double>& positions, double slider_length,
+                   std::size_t nodes_in_contact);
+
 
 }  // namespace friction

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace friction {
 
@@ -40,8 +41,11 @@ std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents() {
     const LoadCellReading* previous = nullptr;
     double shear_impulse = 0.0, normal_impulse = 0.0, span = 0.0;
     // The peak F_X is watched until the whole interface has slipped (SlipEvent::peak_shear_force).
+    // The nodes lifted throughout have no first-unstick time (NaN), which fmax passes over.
     const double peak_until =
-        event.global ? *std::max_element(event.first_unstick_time.begin(), event.first_unstick_time.end())
+        event.global ? std::accumulate(event.first_unstick_time.begin(), event.first_unstick_time.end(),
+                                       -std::numeric_limits<double>::infinity(),
+                                       [](double a, double b) { return std::fmax(a, b); })
                      : event.end_time;
     for (const LoadCellReading& reading : load_cells_) {
       if (reading.time <= event.onset_time) {
@@ -90,6 +94,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
     current_.index = next_index_++;
     current_.onset_time = frame.time;
     current_.first_unstick_time.assign(n, std::numeric_limits<double>::quiet_NaN());
+    in_contact_.start(n);
     double sum = 0.0;
     int count = 0;
     for (std::size_t node = 0; node < n; ++node) {
@@ -99,6 +104,9 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
     }
     current_.nucleation_position = sum / count;
   }
+  const auto detached = static_cast<std::size_t>(
+      std::count(frame.state.begin(), frame.state.end(), static_cast<std::uint8_t>(ContactState::Detached)));
+  in_contact_.note(detached, [&frame](std::size_t node) { return static_cast<ContactState>(frame.state[node]); });
   for (std::size_t node = 0; node < n; ++node) {
     if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) &&
         std::isnan(current_.first_unstick_time[node])) {
@@ -114,7 +122,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = frame.slip[node] - last_stuck_frame_->slip[node];
   // The slipped nodes are those seen sliding, not merely moved: with an interfacial stiffness stuck
   // nodes move elastically, and detached nodes move freely.
-  measureExtent(event, frame.position, sliderLength());
+  measureExtent(event, frame.position, sliderLength(), in_contact_.count());
   measureFronts(event, frame.position, front_fit_nodes_, longitudinal_speed_);
   last_stuck_frame_ = frame;
   ended_.push_back(std::move(event));

@@ -38,6 +38,7 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     current_.onset_shear_force = shear_at(current_.onset_time);
     current_.peak_shear_force = current_.onset_shear_force;
     slipped_ = 0;
+    in_contact_.start(n);
     current_.onset_normal_force = loads.normal;
     shear_impulse_ = 0.0;
     normal_impulse_ = 0.0;
@@ -49,7 +50,10 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
   }
   if (!in_event_) return false;
-  const bool was_global = slipped_ == positions_.size();
+  in_contact_.note(static_cast<std::size_t>(contact.detachedCount()), [&contact](std::size_t node) {
+    return contact.state(static_cast<int>(node));
+  });
+  const bool was_global = slipped_ == in_contact_.count();
   double last_first_unstick = step_start;  // of the nodes slipping for the first time in this step
   for (int node : unstuck) {
     if (!std::isnan(current_.first_unstick_time[node])) continue;
@@ -66,7 +70,7 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
   // The peak is watched until the whole interface has slipped. F_X is linear across the step, so its
   // value where this step's part of the watch ends bounds it (the start was noted at the onset or by
   // the step before).
-  if (!was_global) notePeak(shear_at(slipped_ == positions_.size() ? last_first_unstick : end_time));
+  if (!was_global) notePeak(shear_at(slipped_ == in_contact_.count() ? last_first_unstick : end_time));
   // The part of this step inside the event, F_X linear across the step as in shear_at.
   const double from = std::max(step_start, current_.onset_time);
   if (end_time > from) {
@@ -93,7 +97,7 @@ void SlipEventDetector::finish(double end_time, const Vector& u, double end_shea
   const std::size_t n = positions_.size();
   event.node_slip.resize(n);
   for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = u[dofs_[node]] - onset_u_[node];
-  measureExtent(event, positions_, slider_length_);
+  measureExtent(event, positions_, slider_length_, in_contact_.count());
   measureFronts(event, positions_, fit_nodes_, longitudinal_speed_);
   if (event.global) ++global_count_;
   events_.push_back(std::move(event));
@@ -196,7 +200,13 @@ FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
   return summary;
 }
 
-void measureExtent(SlipEvent& event, const std::vector<double>& positions, double slider_length) {
+void ContactDuringEvent::start(std::size_t nodes) {
+  touched_.assign(nodes, 0);
+  count_ = 0;
+}
+
+void measureExtent(SlipEvent& event, const std::vector<double>& positions, double slider_length,
+                   std::size_t nodes_in_contact) {
   double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
   std::size_t slipped = 0;
   for (std::size_t node = 0; node < positions.size(); ++node) {
@@ -207,7 +217,7 @@ void measureExtent(SlipEvent& event, const std::vector<double>& positions, doubl
   }
   event.slip_min_x = x_min;
   event.slip_max_x = x_max;
-  event.global = slipped == positions.size();
+  event.global = slipped > 0 && slipped == nodes_in_contact;
   if (slipped == 0) {
     event.rupture_length = 0.0;
   } else if (positions.size() == 1) {
