@@ -24,8 +24,14 @@ TEST(LoadingProtocol, RampHoldDriveBecomesATimedSchedule) {
       "  - {action: move_to, speed: 1.0e-3, target: 0.0, duration: .inf}\n"
       "end: {global_events: 3}\n"
       "ramp_commands: 4\n");
-  const auto schedule = scheduleProtocol(protocol, 1.0, 1000.0);
-  ASSERT_EQ(schedule.size(), 4u + 3u);
+  const auto whole = scheduleProtocol(protocol, 1.0, 1000.0);
+  ASSERT_EQ(whole.size(), 1u + 4u + 3u);
+  // The stage holds from the start while F_Z ramps: the protocol drives it, not the scene's program
+  // (which had driven it through stop_and_go's ramp; found by a new-user walkthrough).
+  EXPECT_EQ(whole[0].kind, TimedCommand::Kind::Stage);
+  EXPECT_EQ(whole[0].stage.mode, StageMode::Hold);
+  EXPECT_DOUBLE_EQ(whole[0].time, 1.0);
+  const std::vector<TimedCommand> schedule(whole.begin() + 1, whole.end());
   for (int k = 0; k < 4; ++k) {
     EXPECT_EQ(schedule[k].kind, TimedCommand::Kind::NormalLoad);
     EXPECT_DOUBLE_EQ(schedule[k].time, 1.0 + 0.0025 * k);
@@ -37,6 +43,12 @@ TEST(LoadingProtocol, RampHoldDriveBecomesATimedSchedule) {
   EXPECT_DOUBLE_EQ(schedule[5].time, 1.015);
   EXPECT_EQ(schedule[6].stage.mode, StageMode::Position);
   EXPECT_DOUBLE_EQ(schedule[6].time, 1.115);
+  // A protocol that starts with a stage step needs no hold before it.
+  const auto driven = scheduleProtocol(parseProtocol("steps:\n  - {action: drive, speed: 4.0e-4, duration: .inf}\n"
+                                                     "end: {global_events: 1}\n"),
+                                       0.0, 1000.0);
+  ASSERT_EQ(driven.size(), 1u);
+  EXPECT_EQ(driven[0].stage.mode, StageMode::Velocity);
   EXPECT_FALSE(protocolEnded(protocol.end, 2, 0.0, 10.0));
   EXPECT_TRUE(protocolEnded(protocol.end, 3, 0.0, 10.0));
 }

@@ -79,6 +79,14 @@ std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, doub
   std::vector<TimedCommand> schedule;
   double time = start_time;
   double normal_force = start_normal_force;
+  // The protocol, not the scene's stage program, drives the stage from its start: one that begins by
+  // changing F_Z holds the stage until its first stage step (the scene's program had driven it meanwhile).
+  if (!protocol.steps.empty() && protocol.steps.front().action == ProtocolAction::NormalLoad) {
+    TimedCommand hold;
+    hold.time = start_time;
+    hold.stage = {StageMode::Hold, 0.0, 0.0};
+    schedule.push_back(hold);
+  }
   for (const ProtocolStep& step : protocol.steps) {
     if (step.action == ProtocolAction::NormalLoad) {
       const int commands = step.ramp_time > 0.0 ? protocol.ramp_commands : 1;

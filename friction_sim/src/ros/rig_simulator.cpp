@@ -179,7 +179,7 @@ void RigSimulator::publishClock(double time) {
   clock_pub_.publish(clock);
 }
 
-void RigSimulator::publishStageState(const LoadCellReading& cells) {
+void RigSimulator::publishStageState(const LoadCellReading& cells, double travel) {
   const Stage& stage = simulation_->stage();
   friction_msgs::StageState msg;
   msg.header.stamp = toStamp(cells.time);
@@ -188,7 +188,7 @@ void RigSimulator::publishStageState(const LoadCellReading& cells) {
   msg.position = cells.stage_position;
   msg.velocity = stage.velocity();
   msg.target = stage.current().target;
-  msg.travel = stage.travel();
+  msg.travel = travel;
   msg.shear_force = cells.shear_force;
   msg.normal_force = cells.normal_force;
   msg.global_events = simulation_->globalEventCount();
@@ -203,6 +203,7 @@ RigSimulator::Readings RigSimulator::readings() const {
   if (scene_.model == ModelKind::Lattice2D) now.gauges = simulation_->gaugeProfile();
   now.frame = simulation_->interfaceFrame();
   now.lattice = simulation_->snapshot();
+  now.stage_travel = simulation_->stage().travel();
   return now;
 }
 
@@ -226,7 +227,10 @@ void RigSimulator::publishAcrossJump(const Readings& before) {
     emit(lattice_pub_, "lattice", toMsg(interpolate(before.lattice, after.lattice, next_lattice_), options_.frame_id));
   }
   for (; next_stage_state_ <= t; next_stage_state_ += 1.0 / options_.stage_state_rate) {
-    publishStageState(interpolate(before.cells, after.cells, next_stage_state_));
+    const LoadCellReading cells = interpolate(before.cells, after.cells, next_stage_state_);
+    // The stage keeps its velocity along a jump: its travel is affine in time too.
+    const double w = (next_stage_state_ - before.cells.time) / (after.cells.time - before.cells.time);
+    publishStageState(cells, before.stage_travel + w * (after.stage_travel - before.stage_travel));
   }
 }
 
@@ -250,7 +254,7 @@ void RigSimulator::publishInstruments() {
     emit(events_pub_, "slip_events",
          toMsg(simulation_->events().back(), interface_positions_, scene_.geometry.length, wave_speeds_, frame));
   }
-  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState(simulation_->loadCells());
+  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState(simulation_->loadCells(), simulation_->stage().travel());
   if (due(t, next_lattice_, options_.lattice_rate)) {
     emit(lattice_pub_, "lattice", toMsg(simulation_->snapshot(), frame));
   } else if (ros::WallTime::now() >= next_snapshot_ && lattice_pub_.getNumSubscribers() > 0) {
@@ -384,7 +388,7 @@ void RigSimulator::run() {
       continue;
     }
     if (paused_) {
-      publishStageState(simulation_->loadCells());  // so that a controller learns the time and F_Z while the rig waits
+      publishStageState(simulation_->loadCells(), simulation_->stage().travel());  // so that a controller learns the time and F_Z while the rig waits
       publishClock(simulation_->time());  // nodes on simulated time, and `rostopic echo /clock`, see it stand still
       if (lattice_pub_.getNumSubscribers() > 0) lattice_pub_.publish(toMsg(simulation_->snapshot(), options_.frame_id));
       ros::WallDuration(0.05).sleep();
@@ -421,7 +425,7 @@ void RigSimulator::run() {
            << " at t = " << simulation_->time() << " s";
     end_reason = reason.str();
   }
-  publishStageState(simulation_->loadCells());
+  publishStageState(simulation_->loadCells(), simulation_->stage().travel());
   // The summary is the run since the last reset: its simulated time and steps start there, and its wall
   // time is the time spent running since, not waiting paused (for a controller, or a user).
   RunSummary summary = summarize(*simulation_, runningWallTime());

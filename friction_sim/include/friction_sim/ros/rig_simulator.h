@@ -128,13 +128,15 @@ class RigSimulator {
     GaugeProfile gauges;  ///< empty for the chain
     InterfaceFrame frame;
     LatticeSnapshot lattice;
+    double stage_travel = 0.0;  ///< m
   };
   Readings readings() const;
   /// After a fast-forward jump: every instrument's reading at every publication time the jump passed,
   /// interpolated from `before` the jump and after it (along a jump the statics are nearly affine in time).
   void publishAcrossJump(const Readings& before);
   void publishClock(double time);
-  void publishStageState(const LoadCellReading& cells);
+  /// The stage state with the load cells' time, position and forces and the stage's `travel` (m) then.
+  void publishStageState(const LoadCellReading& cells, double travel);
   void applyDueCommands();
   std::string accept(const friction_msgs::StageCommand& msg);
   void onCommand(const friction_msgs::StageCommand::ConstPtr& msg);
