@@ -8,6 +8,7 @@
 #include "friction_sim/ros/precursor_detector.h"
 #include "friction_sim/ros/rig_simulator.h"
 #include "friction_sim/ros/stage_controller.h"
+#include "friction_sim/scene_io.h"
 #include "friction_sim/yaml_fields.h"
 
 namespace friction {
@@ -140,6 +141,12 @@ TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
   EXPECT_NE(checkCommand(msg, simulation).find("normal load -10 N"), std::string::npos);
   msg.normal_force = std::numeric_limits<double>::infinity();
   EXPECT_NE(checkCommand(msg, simulation).find("finite F_Z"), std::string::npos);
+  // Beyond a small strain (found by a new-user walkthrough: 10⁹ N was accepted and the run went NaN).
+  msg.normal_force = 1e9;
+  const double largest = largestNormalForce(simulation.scene());
+  EXPECT_NE(checkCommand(msg, simulation).find("at most " + std::to_string(static_cast<int>(largest)) + " N"),
+            std::string::npos)
+      << checkCommand(msg, simulation);
   msg.mode = 9;
   EXPECT_NE(checkCommand(msg, simulation).find("mode 9 is unknown"), std::string::npos);
 }

@@ -107,6 +107,12 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [3.0, 2.0, 1.0]}\n"
                     "friction: {interfacial_stiffness: 1.0e8}",
                     "friction.interfacial_stiffness: value 100000000", "0 (rigid sticking) with a chain.initial_shear"},
+        // A segment without an end before another (found by a new-user walkthrough).
+        InvalidCase{"stage: {program: [{mode: velocity, speed: 4.0e-4}, {mode: hold}]}",
+                    "stage.program[0].duration: value inf", "a finite duration > 0 s: later segments would never run"},
+        // 10⁶ N on pmma_2d compressed it by 40 %, folded the lattice and filled the run with NaN.
+        InvalidCase{"load: {normal_force: 1.0e6}", "load.normal_force: value 1000000",
+                    "at most 126000 N (a mean normal stress F_Z/(L*B) of 5 % of E"},
         // µ_s·F_Z/3 = 256 N per block: the first would slide at t = 0.
         InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [400.0, 0.0, 0.0]}",
                     "chain.initial_shear[0]: value 400", "|f| <= mu_s * w_0 = 256 N, the block's static threshold"}));

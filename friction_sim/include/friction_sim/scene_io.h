@@ -40,6 +40,11 @@ Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, 
 /// limit (s), which the check computes anyway.
 std::vector<std::string> validateScene(const Scene& scene, double* stability_limit = nullptr);
 
+/// N, the largest F_Z the scene takes: a mean normal stress F_Z/(L·B) of 5 % of E. Beyond it the
+/// slider's compression is no small strain, which its linear elasticity assumes (F_Z = 10⁶ N, 40 % of E
+/// on pmma_2d, folded the lattice and filled the run with NaN).
+double largestNormalForce(const Scene& scene);
+
 /// What is allowed but probably not meant (e.g. a slip-weakening length shorter than one lattice
 /// spacing, which the lattice cannot resolve); printed by the runner and the simulator node.
 std::vector<std::string> sceneWarnings(const Scene& scene);

@@ -43,6 +43,10 @@ class Checker {
 
 }  // namespace
 
+double largestNormalForce(const Scene& scene) {
+  return 0.05 * scene.material.youngs_modulus * scene.geometry.length * scene.geometry.width;
+}
+
 std::vector<std::string> validateScene(const Scene& s, double* stability_limit) {
   Checker check;
   const bool lattice = s.model == ModelKind::Lattice2D;
@@ -100,6 +104,11 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
   check.nonNegative("friction.interfacial_stiffness", s.friction.interfacial_stiffness);
 
   check.positive("load.normal_force", s.load.normal_force);
+  if (check.clean({"geometry.", "material.youngs_modulus", "load.normal_force"})) {
+    std::ostringstream allowed;
+    allowed << "at most " << largestNormalForce(s) << " N (a mean normal stress F_Z/(L*B) of 5 % of E: a small strain)";
+    check.require(s.load.normal_force <= largestNormalForce(s), "load.normal_force", s.load.normal_force, allowed.str());
+  }
   check.nonNegative("load.mattress_stiffness", s.load.mattress_stiffness);
   check.nonNegative("load.mattress_horizontal_stiffness", s.load.mattress_horizontal_stiffness);
 
@@ -124,7 +133,12 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
     const std::string where = "stage.program[" + std::to_string(i) + "]";
     check.require(std::isfinite(segment.speed) && std::abs(segment.speed) <= s.stage.max_speed, where + ".speed",
                   segment.speed, "|speed| <= stage.max_speed");
-    check.require(segment.duration > 0.0, where + ".duration", segment.duration, "a duration > 0 s (.inf allowed)");
+    if (i + 1 < s.stage.program.size()) {
+      check.require(segment.duration > 0.0 && std::isfinite(segment.duration), where + ".duration",
+                    segment.duration, "a finite duration > 0 s: later segments would never run");
+    } else {
+      check.require(segment.duration > 0.0, where + ".duration", segment.duration, "a duration > 0 s (.inf allowed)");
+    }
     if (segment.mode == StageMode::Position) {
       check.require(segment.speed > 0.0, where + ".speed", segment.speed, "a travel speed > 0 in position mode");
       check.require(std::isfinite(segment.target), where + ".target", segment.target, "a finite position");

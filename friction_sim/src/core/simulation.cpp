@@ -465,8 +465,9 @@ std::string Simulation::setStopCondition(const StopSpec& stop) {
 
 std::string Simulation::checkNormalLoad(double normal_force) const {
   std::ostringstream reason;
-  if (!std::isfinite(normal_force) || normal_force <= 0.0) {
-    reason << "normal load " << normal_force << " N is not allowed; allowed: a finite F_Z > 0 N";
+  if (!std::isfinite(normal_force) || normal_force <= 0.0 || normal_force > largestNormalForce(scene_)) {
+    reason << "normal load " << normal_force << " N is not allowed; allowed: a finite F_Z > 0 N, at most "
+           << largestNormalForce(scene_) << " N (a mean normal stress of 5 % of E: a small strain)";
   } else if (!model_->takesNormalLoadChanges()) {
     reason << "normal load " << normal_force
            << " N refused: F_Z cannot change during a run with load.top spring_mattress (its plate is placed "
