@@ -98,6 +98,8 @@ INSTANTIATE_TEST_SUITE_P(
                     "a finite number >= 0"},
         InvalidCase{"frictoin: {law: amontons_coulomb}", "frictoin: unknown key", "allowed keys here"},
         InvalidCase{"friction: {mu_s: 0.4}", "friction.mu_s: unknown key", "static_coefficient"},
+        // The first of two would have won without a word (found by a new-user walkthrough).
+        InvalidCase{"geometry:\n  length: 0.14\n  length: 0.2", "geometry.length: given more than once", "give it once"},
         InvalidCase{"friction: {law: coulomb}", "friction.law: value 'coulomb'", "amontons_coulomb | slip_weakening"},
         InvalidCase{"lattice: {nodes_x: many}", "lattice.nodes_x: value 'many'", "integer"},
         InvalidCase{"stage: {program: [{mode: velocity, speed: 5.0}]}", "stage.program[0].speed: value 5",

@@ -98,10 +98,13 @@ class YamlFieldReader {
     }
   }
 
-  /// Reports every key of the current mapping that no field claimed.
+  /// Reports every key of the current mapping that no field claimed, and every key given twice (YAML
+  /// forbids it; yaml-cpp keeps both and the first would win without a word).
   void rejectUnknownKeys() {
+    std::set<std::string> seen;
     for (const auto& entry : node_) {
       const std::string key = entry.first.as<std::string>();
+      if (!seen.insert(key).second) problems_.push_back(path(key) + ": given more than once; give it once");
       if (!used_.count(key)) {
         std::string allowed;
         for (const auto& name : used_) allowed += (allowed.empty() ? "" : ", ") + name;
