@@ -79,7 +79,8 @@ struct EnergyBudget {
   double residual() const {
     return work_in - (elastic - initial_elastic + kinetic + friction_dissipation + viscous_dissipation);
   }
-  /// residual relative to the largest term of the budget
+  /// residual relative to the largest term of the budget; NaN where no energy changed hands (every term
+  /// below 10⁻⁹ of the stored energy)
   double relativeResidual() const;
 };
 

@@ -53,7 +53,8 @@ void printSummary(std::ostream& out, const RunSummary& s) {
   }
   out << "  mu_s,macro = F_X/F_Z at the first global event: " << s.static_friction_macro << "\n"
       << "  mu_k,macro = mean F_X / mean F_Z over that event: " << s.kinetic_friction_macro << "\n"
-      << "  energy-balance residual (relative): " << std::setprecision(3) << s.relative_energy_residual << "\n";
+      << "  energy-balance residual (relative): " << std::setprecision(3) << s.relative_energy_residual
+      << (std::isnan(s.relative_energy_residual) ? " (no energy changed hands: nothing to balance)" : "") << "\n";
 }
 
 void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, const Scene& scene) {
