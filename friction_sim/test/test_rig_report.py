@@ -116,6 +116,14 @@ class RigReportTest(unittest.TestCase):
         self.assertNotEqual(done.returncode, 0)
         self.assertIn("holds no /rig/precursor_detector/slip_events; its topics:", done.stderr)
 
+    def test_a_missing_or_broken_bag_is_refused_in_a_sentence(self):
+        for path, reason in [(os.path.join(self.work, "missing.bag"), "No such file"),
+                             (os.path.join(ROOT, "README.md"), "")]:
+            done = subprocess.run(["/usr/bin/python3", RIG_REPORT, path], capture_output=True, text=True, timeout=120)
+            self.assertNotEqual(done.returncode, 0)
+            self.assertIn("rig_report: cannot read the bag %s: %s" % (path, reason), done.stderr)
+            self.assertNotIn("Traceback", done.stderr)
+
     def test_the_rig_is_found_in_any_namespace_or_chosen_among_several(self):
         for namespace in ["/bench", ""]:  # "": the root namespace, topics /load_cells ...
             write_bag(self.bag, namespace=namespace)
