@@ -56,6 +56,14 @@ TEST(SceneFiles, OverridesAreParsedAndValidatedLikeTheFile) {
   EXPECT_DOUBLE_EQ(changed.pusher.height, 0.01);
   EXPECT_DOUBLE_EQ(changed.friction.kinetic_coefficient, 0.2);
   EXPECT_THROW(overrideScene(base, {{"pusher.hieght", "0.01"}}), SceneError);
+  // A list is replaced whole, which the refusal of one element says (found by a new-user walkthrough).
+  try {
+    overrideScene(base, {{"stage.program[0].speed", "4e-3"}});
+    ADD_FAILURE() << "accepted";
+  } catch (const SceneError& error) {
+    EXPECT_NE(std::string(error.what()).find("give the whole list in YAML, stage.program=[...]"), std::string::npos)
+        << error.what();
+  }
 }
 
 struct InvalidCase {

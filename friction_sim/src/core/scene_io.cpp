@@ -262,6 +262,14 @@ std::string overridesYaml(const std::vector<std::pair<std::string, std::string>>
       problems.push_back("override '" + key + "': expected a dotted key such as pusher.height");
       continue;
     }
+    const std::size_t index = key.find('[');
+    if (index != std::string::npos) {
+      // A list is one field: it is replaced whole (the unknown key "stage.program[0]" told no more).
+      const std::string list = key.substr(0, index);
+      problems.push_back("override '" + key + "': an element of a list cannot be set on its own; give the whole list "
+                         "in YAML, " + list + "=[...] (as in sweeps/stage_speed.yaml)");
+      continue;
+    }
     YAML::Node node = root;
     for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
       if (!node[parts[i]]) node[parts[i]] = YAML::Node(YAML::NodeType::Map);
