@@ -545,8 +545,11 @@ def write(data):
         L.append(global_row(k.split("=")[1], v))
     global_speeds = [(k.split("=")[1], f(first_global(v), "median_front_speed_m_s")) for k, v in by_value(laws)]
     L += ["", "ξ_µ = 0 is Amontons–Coulomb. Slip weakening raises µ_s,macro and slows the global front (%s); "
-          "at ξ_µ = 10 µm the first event already runs the whole interface as a slow front (well below c_R/10) — "
-          "the slow fronts that Amontons–Coulomb never gives. (The runner warns for every ξ_µ here, each shorter than the "
+          "at ξ_µ = 10 µm the first event already spans the whole interface, and its 'front' is no dynamic front: "
+          "the interface creeps as the stage loads it, its speed set by the stage (measured on 2026-11-25 with "
+          "friction_run: 0.103, 0.411 and 4.10 m/s at V = 0.1, 0.4 and 4 mm/s, in proportion; µ_s,macro 0.2357 "
+          "at all three). The experiments' slow fronts run dynamically, whatever V; the rig gives none, with "
+          "either law. (The runner warns for every ξ_µ here, each shorter than the "
           "lattice spacing l = 2.5 mm, and gives the cohesive zone it sets, G·ξ_µ/((µ_s − µ_k)·σ̄): 0.86 l at 1 µm, "
           "2.6 l at 3 µm and 8.6 l at 10 µm, so only 10 µm is resolved by three spacings or more.)" % ", ".join("%.0f m/s at ξ_µ = %s m" % (speed, xi) for xi, speed in global_speeds[:3]), ""]
 
