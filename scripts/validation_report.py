@@ -233,8 +233,8 @@ def write(data):
     for e in pre:
         L.append("| %s | %.4f | %.3f | %.1f | %.0f |" % (e["index"], f(e, "shear_ratio"), f(e, "length_ratio"),
                                                          f(e, "nucleation_x_m") * 1e3, f(e, "median_front_speed_m_s")))
-    L += ["", "*Agreement*: yes — every precursor starts near the trailing edge (within %.1f mm; the pushed "
-          "node is at 5 mm), arrests, and the arrest points move out in discrete steps with rising F_X; some "
+    L += ["", "*Agreement*: yes — every precursor starts near the trailing edge (its nucleation within %.1f mm of "
+          "x = 0, where the pusher acts 5 mm up), arrests, and the arrest points move out in discrete steps with rising F_X; some "
           "events are single-node slips (L_p = 0) that arrest at once." % max(f(e, "nucleation_x_m") * 1e3 for e in pre), ""]
 
     # 2. Collapse, kink, V and h
