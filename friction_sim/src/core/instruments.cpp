@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace friction {
 
@@ -25,6 +26,14 @@ void blend(const std::vector<double>& from, std::vector<double>& to, double w) {
   for (std::size_t i = 0; i < to.size() && i < from.size(); ++i) to[i] = blend(from[i], to[i], w);
 }
 
+/// `b` moved to time t, and b's weight at t against `a` (the rest is blended by the caller).
+template <class Reading>
+std::pair<Reading, double> startAt(const Reading& a, const Reading& b, double t) {
+  Reading out = b;
+  out.time = t;
+  return {std::move(out), weightAt(a.time, b.time, t)};
+}
+
 void blend(const GaugeStresses& from, GaugeStresses& to, double w) {
   blend(from.sigma_xx, to.sigma_xx, w);
   blend(from.sigma_zz, to.sigma_zz, w);
@@ -33,9 +42,7 @@ void blend(const GaugeStresses& from, GaugeStresses& to, double w) {
 }  // namespace
 
 LoadCellReading interpolate(const LoadCellReading& a, const LoadCellReading& b, double t) {
-  const double w = weightAt(a.time, b.time, t);
-  LoadCellReading out = b;
-  out.time = t;
+  auto [out, w] = startAt(a, b, t);
   out.stage_position = blend(a.stage_position, b.stage_position, w);
   out.shear_force = blend(a.shear_force, b.shear_force, w);
   out.normal_force = blend(a.normal_force, b.normal_force, w);
@@ -44,16 +51,13 @@ LoadCellReading interpolate(const LoadCellReading& a, const LoadCellReading& b, 
 }
 
 GaugeProfile interpolate(const GaugeProfile& a, const GaugeProfile& b, double t) {
-  GaugeProfile out = b;
-  out.time = t;
-  blend(a.stress, out.stress, weightAt(a.time, b.time, t));
+  auto [out, w] = startAt(a, b, t);
+  blend(a.stress, out.stress, w);
   return out;
 }
 
 InterfaceFrame interpolate(const InterfaceFrame& a, const InterfaceFrame& b, double t) {
-  const double w = weightAt(a.time, b.time, t);
-  InterfaceFrame out = b;
-  out.time = t;
+  auto [out, w] = startAt(a, b, t);
   if (t < b.time) out.state = a.state;
   for (auto field : {&InterfaceFrame::slip_velocity, &InterfaceFrame::slip, &InterfaceFrame::normal_force,
                      &InterfaceFrame::friction_force, &InterfaceFrame::normal_stress, &InterfaceFrame::shear_stress}) {
@@ -63,13 +67,9 @@ InterfaceFrame interpolate(const InterfaceFrame& a, const InterfaceFrame& b, dou
 }
 
 LatticeSnapshot interpolate(const LatticeSnapshot& a, const LatticeSnapshot& b, double t) {
-  const double w = weightAt(a.time, b.time, t);
-  LatticeSnapshot out = b;
-  out.time = t;
+  auto [out, w] = startAt(a, b, t);
   if (t < b.time) out.interface_state = a.interface_state;
-  blend(a.x, out.x, w);
-  blend(a.z, out.z, w);
-  blend(a.speed, out.speed, w);
+  for (auto field : {&LatticeSnapshot::x, &LatticeSnapshot::z, &LatticeSnapshot::speed}) blend(a.*field, out.*field, w);
   blend(a.stress, out.stress, w);
   out.stage_position = blend(a.stage_position, b.stage_position, w);
   out.normal_force = blend(a.normal_force, b.normal_force, w);
