@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "friction_sim/simulation.h"
@@ -94,6 +95,24 @@ TEST(FastForward, AHoldCommandedWhileAThresholdIsApproachedJumpsAgain) {
   EXPECT_GT(simulation.jumps(), jumps);
   EXPECT_LT(simulation.steps() - steps, 10);
   EXPECT_TRUE(simulation.events().empty());
+}
+
+TEST(FastForward, AStageAtRestWithNoEndTakesNoEndlessJump) {
+  // Held, with nothing due and no time limit, a jump would have no end: it is not taken (it went to
+  // t = inf and left NaN, found by a review); one with an end is.
+  Scene scene = testing::coarseSliderScene(true);
+  scene.stage.program = {StageSegment{StageMode::Hold, 0.0}};
+  Simulation simulation(scene);
+  // As a controller whose protocol ends on a count of events sets it.
+  const double endless = std::numeric_limits<double>::infinity();
+  ASSERT_EQ(simulation.setStopCondition(StopSpec{2, endless, endless}), "");
+  simulation.advance(std::numeric_limits<double>::infinity());
+  EXPECT_EQ(simulation.jumps(), 0);
+  EXPECT_TRUE(std::isfinite(simulation.time()));
+  EXPECT_TRUE(simulation.displacements().allFinite());
+  simulation.advance(0.01);
+  EXPECT_EQ(simulation.jumps(), 1);
+  EXPECT_EQ(simulation.time(), 0.01);
 }
 
 TEST(FastForward, AStageTravelLimitEndsTheRunWithinAStepOfIt) {

@@ -49,13 +49,16 @@ def descendant_named(root, name):
 
 
 class SlowRun:
-    """The default experiment at a hundredth of real time, with its simulator's pid once its run is under
-    way: once the controller has said that its protocol started."""
+    """The default experiment at a hundredth of real time (or the launch with `args`), with its
+    simulator's pid once its run is under way: once the controller has said that its protocol started."""
 
     STARTED = "stage controller: protocol started"
 
+    def __init__(self, *args):
+        self.args = list(args) or ["real_time_factor:=0.01"]
+
     def __enter__(self):
-        self.process = subprocess.Popen([RIG_LAUNCH, RIG, "real_time_factor:=0.01"], stdout=subprocess.PIPE,
+        self.process = subprocess.Popen([RIG_LAUNCH, RIG] + self.args, stdout=subprocess.PIPE,
                                         stderr=subprocess.STDOUT, text=True)
         self.lines = []
         self.started = threading.Event()
@@ -131,6 +134,23 @@ class RigLaunchStatusTest(unittest.TestCase):
         # The simulator ended its run and wrote its summary: roslaunch stopped it, not the kill.
         self.assertIn("interrupted by a signal", output)
         self.assertFalse(os.path.exists("/proc/%d" % run.simulator), "the simulator outlived the launch")
+
+    def test_a_stage_held_without_end_runs_on_and_stops_when_interrupted(self):
+        # Unpaced, a held stage with nothing due and no end time jumped to t = inf, and the simulator
+        # published forever without hearing the signal (found by a review).
+        work = tempfile.mkdtemp(prefix="rig_launch_test_")
+        self.addCleanup(shutil.rmtree, work)
+        protocol = os.path.join(work, "held.yaml")
+        with open(protocol, "w") as handle:
+            handle.write("steps:\n  - {action: hold, duration: .inf}\nend: {global_events: 1}\n")
+        with SlowRun("protocol:=" + protocol, "analysis:=false") as run:
+            self.assertIsNotNone(run.simulator, "the simulator did not start")
+            threading.Event().wait(2.0)
+            run.process.send_signal(signal.SIGTERM)
+            status, output = run.finish()
+        self.assertEqual(status, 130, output)
+        self.assertIn("interrupted by a signal", output)
+        self.assertRegex(output, r"simulated [0-9.e+-]+ s in [0-9]+ steps")
 
     def test_a_run_that_reaches_its_stop_condition_succeeds_with_paths_relative_to_the_users_directory(self):
         # The single block slips at µ_s·F_Z = 0.4 × 1920 N three times and stops (its scene's stop). The

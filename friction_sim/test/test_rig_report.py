@@ -33,10 +33,12 @@ def event(index, onset, shear_ratio, rupture_length, slider_length=0.14):
     return msg
 
 
-def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None, normal_load_rise=0.0):
+def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None, normal_load_rise=0.0,
+              commands=True):
     """Load cells and frames for 0.1 s (F_Z rising by `normal_load_rise` N per ms), two events from the
     simulator and, unless not `detector`, the same two, with the detector's slightly later reading of F_X,
-    from the detector; `also` another rig's namespace with the same."""
+    from the detector; `also` another rig's namespace with the same; unless not `commands`, a drive and a
+    normal-load command as applied."""
     if also:
         write_bag(path + ".also", also, detector, slider_length)
     with rosbag.Bag(path, "w") as bag:
@@ -45,11 +47,12 @@ def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=No
                 for topic, msg, stamp in other.read_messages():
                     bag.write(topic, msg, stamp)
         bag.write(namespace + "/scene", String(data=SCENE), rospy.Time(0, 1))
-        drive = StageCommand(mode=StageCommand.VELOCITY, speed=4e-4, target=0.5, normal_force=7.0)
-        bag.write(namespace + "/applied_commands", drive, rospy.Time(0, 2))
-        load = StageCommand(mode=StageCommand.NORMAL_LOAD, normal_force=2500.0)
-        load.header.stamp = rospy.Time.from_sec(0.05)
-        bag.write(namespace + "/applied_commands", load, load.header.stamp)
+        if commands:
+            drive = StageCommand(mode=StageCommand.VELOCITY, speed=4e-4, target=0.5, normal_force=7.0)
+            bag.write(namespace + "/applied_commands", drive, rospy.Time(0, 2))
+            load = StageCommand(mode=StageCommand.NORMAL_LOAD, normal_force=2500.0)
+            load.header.stamp = rospy.Time.from_sec(0.05)
+            bag.write(namespace + "/applied_commands", load, load.header.stamp)
         for step in range(1, 101):
             stamp = rospy.Time.from_sec(step * 1e-3)
             wrench = WrenchStamped()
@@ -142,11 +145,15 @@ class RigReportTest(unittest.TestCase):
         def figure_height():
             with open(os.path.join(self.work, "loading_curve.png"), "rb") as png:
                 return struct.unpack(">II", png.read(24)[16:24])[1]  # IHDR: width, height
-        self.assertEqual(self.report().returncode, 0)
-        self.assertEqual(figure_height(), 396)
-        write_bag(self.bag, normal_load_rise=5.0)
-        self.assertEqual(self.report().returncode, 0)
-        self.assertEqual(figure_height(), 550)
+        def height_with(**bag):
+            write_bag(self.bag, **bag)
+            self.assertEqual(self.report().returncode, 0)
+            return figure_height()
+        self.assertEqual(height_with(commands=False), 396)
+        self.assertEqual(height_with(commands=True), 550)  # a normal-load command
+        self.assertEqual(height_with(commands=False, normal_load_rise=5.0), 550)  # 500 N over the run
+        # A spring mattress's F_Z moves a little with the slider: 0.01 % is no change of the load.
+        self.assertEqual(height_with(commands=False, normal_load_rise=0.002), 396)
 
     def test_an_unknown_slider_length_gives_no_length_ratio(self):
         # The detector's events on a single block without a scene carry L = 0.

@@ -18,6 +18,10 @@ struct LoadCellReading {
   int sliding_nodes = 0;              ///< N_sliding
 };
 
+/// The weight of the later of two readings, at `b_time` (s), at time t (s) against the earlier, at
+/// `a_time`: 0 at a's time, 1 at b's (and 1 if the times coincide).
+double interpolationWeight(double a_time, double b_time, double t);
+
 /// The load cells at time t between two readings, linearly (exact across a fast-forward jump, where
 /// the forces are affine in time); the counters are those of `b`.
 LoadCellReading interpolate(const LoadCellReading& a, const LoadCellReading& b, double t);

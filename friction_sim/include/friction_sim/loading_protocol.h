@@ -57,7 +57,9 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
 LoadingProtocol loadProtocol(const std::string& path);
 
 /// The protocol's commands from `start_time` (s), ramps starting at F_Z = `start_normal_force` (N);
-/// it ends with the first step of infinite duration.
+/// it ends with the first step of infinite duration. The protocol drives the stage from its start: one
+/// that begins with normal_load steps holds the stage until its first stage step (one of normal_load
+/// steps alone holds it throughout).
 std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, double start_time,
                                            double start_normal_force);
 

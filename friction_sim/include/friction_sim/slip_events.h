@@ -19,7 +19,7 @@ struct SlipEvent {
   double onset_shear_force = 0.0;   ///< N, F_X at onset (interpolated within the step)
   double onset_normal_force = 0.0;  ///< N, F_Z at onset
   double end_shear_force = 0.0;     ///< N, F_X at the end (interpolated within the step)
-  /// N, the F_X of largest magnitude from the onset until every interface node has slipped (until the
+  /// N, the F_X of largest magnitude from the onset until every interface node in contact has slipped (until the
   /// end if they never all do): the load the interface bore while it gave way. For a dynamic event it is
   /// the onset's, as F_X drops while the front runs; an interface that creeps (slip weakening with a
   /// long ξ_µ) goes on taking load after its first node unsticks and gives way as a whole later. Not
@@ -58,10 +58,14 @@ class ContactDuringEvent {
   void note(std::size_t detached, StateOf state_of) {
     if (count_ == touched_.size()) return;
     for (std::size_t node = 0; node < touched_.size(); ++node) {
-      if (!touched_[node] && (detached == 0 || state_of(node) != ContactState::Detached)) {
-        touched_[node] = 1;
-        ++count_;
-      }
+      if (detached == 0 || state_of(node) != ContactState::Detached) touch(node);
+    }
+  }
+  /// A node seen slipping touched the track, whatever its state now (it may have lifted in the same step).
+  void touch(std::size_t node) {
+    if (!touched_[node]) {
+      touched_[node] = 1;
+      ++count_;
     }
   }
   std::size_t count() const { return count_; }

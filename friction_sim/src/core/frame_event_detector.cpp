@@ -111,6 +111,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
     if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) &&
         std::isnan(current_.first_unstick_time[node])) {
       current_.first_unstick_time[node] = frame.time;
+      in_contact_.touch(node);
     }
   }
   if (sliding) return;

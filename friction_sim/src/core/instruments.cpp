@@ -15,9 +15,11 @@ double EnergyBudget::relativeResidual() const {
   return residual() / scale;
 }
 
+double interpolationWeight(double a_time, double b_time, double t) {
+  return b_time > a_time ? (t - a_time) / (b_time - a_time) : 1.0;
+}
+
 namespace {
-/// The weight of `b` at time t between a's and b's times (b's alone if they coincide).
-double weightAt(double a_time, double b_time, double t) { return b_time > a_time ? (t - a_time) / (b_time - a_time) : 1.0; }
 
 double blend(double from, double to, double w) { return from + w * (to - from); }
 
@@ -31,7 +33,7 @@ template <class Reading>
 std::pair<Reading, double> startAt(const Reading& a, const Reading& b, double t) {
   Reading out = b;
   out.time = t;
-  return {std::move(out), weightAt(a.time, b.time, t)};
+  return {std::move(out), interpolationWeight(a.time, b.time, t)};
 }
 
 void blend(const GaugeStresses& from, GaugeStresses& to, double w) {

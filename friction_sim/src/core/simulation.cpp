@@ -196,6 +196,9 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
     approach_velocity_ = speed;
     return false;
   }
+  // With nothing due, no end and no threshold ahead (a stage at rest) the jump has no end: nothing
+  // would change along it, and a jump to t = inf would leave NaN behind; the caller steps or bounds it.
+  if (!std::isfinite(jump)) return false;
   if (stops_at_threshold) jump *= kApproachShare;
   toward_threshold = stops_at_threshold;
   const double shear_start = evaluation_.shear_force;
@@ -223,6 +226,8 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   detector_.update(time_, 0.0, contact_, u_, {evaluation_.shear_force, evaluation_.shear_force, evaluation_.normal_load});
   pusher_work_ += 0.5 * (shear_start + evaluation_.shear_force) * (stage_end - stage_start);
   ++jumps_;
+  // Any approach before this jump is over: the crossing, if it comes, is found again from here.
+  approaching_threshold_ = false;
   jumped_time_ += jump;
   event_started_ = detector_.inEvent();
   event_ended_ = false;

@@ -60,6 +60,7 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     current_.first_unstick_time[node] = transition_time(node);
     last_first_unstick = std::max(last_first_unstick, current_.first_unstick_time[node]);
     ++slipped_;
+    in_contact_.touch(static_cast<std::size_t>(node));
   }
   const bool ended = contact.slidingCount() == 0;
   double end_time = step_start + dt;

@@ -179,16 +179,20 @@ void RigSimulator::publishClock(double time) {
   clock_pub_.publish(clock);
 }
 
-void RigSimulator::publishStageState(const LoadCellReading& cells, double travel) {
+RigSimulator::StageReading RigSimulator::stageReading() const {
   const Stage& stage = simulation_->stage();
+  return {stage.current().mode, stage.velocity(), stage.current().target, stage.travel()};
+}
+
+void RigSimulator::publishStageState(const LoadCellReading& cells, const StageReading& stage) {
   friction_msgs::StageState msg;
   msg.header.stamp = toStamp(cells.time);
   msg.header.frame_id = options_.frame_id;
-  msg.mode = static_cast<std::uint8_t>(stage.current().mode);
+  msg.mode = static_cast<std::uint8_t>(stage.mode);
   msg.position = cells.stage_position;
-  msg.velocity = stage.velocity();
-  msg.target = stage.current().target;
-  msg.travel = travel;
+  msg.velocity = stage.velocity;
+  msg.target = stage.target;
+  msg.travel = stage.travel;
   msg.shear_force = cells.shear_force;
   msg.normal_force = cells.normal_force;
   msg.global_events = simulation_->globalEventCount();
@@ -203,7 +207,7 @@ RigSimulator::Readings RigSimulator::readings() const {
   if (scene_.model == ModelKind::Lattice2D) now.gauges = simulation_->gaugeProfile();
   now.frame = simulation_->interfaceFrame();
   now.lattice = simulation_->snapshot();
-  now.stage_travel = simulation_->stage().travel();
+  now.stage = stageReading();
   return now;
 }
 
@@ -227,10 +231,12 @@ void RigSimulator::publishAcrossJump(const Readings& before) {
     emit(lattice_pub_, "lattice", toMsg(interpolate(before.lattice, after.lattice, next_lattice_), options_.frame_id));
   }
   for (; next_stage_state_ <= t; next_stage_state_ += 1.0 / options_.stage_state_rate) {
-    const LoadCellReading cells = interpolate(before.cells, after.cells, next_stage_state_);
-    // The stage keeps its velocity along a jump: its travel is affine in time too.
-    const double w = (next_stage_state_ - before.cells.time) / (after.cells.time - before.cells.time);
-    publishStageState(cells, before.stage_travel + w * (after.stage_travel - before.stage_travel));
+    // The stage keeps its motion along a jump, which ends where it changes (a target reached, a segment
+    // over): the motion of its start until its end, and a travel affine in time.
+    StageReading stage = next_stage_state_ < t ? before.stage : after.stage;
+    const double w = interpolationWeight(before.cells.time, after.cells.time, next_stage_state_);
+    stage.travel = before.stage.travel + w * (after.stage.travel - before.stage.travel);
+    publishStageState(interpolate(before.cells, after.cells, next_stage_state_), stage);
   }
 }
 
@@ -254,7 +260,7 @@ void RigSimulator::publishInstruments() {
     emit(events_pub_, "slip_events",
          toMsg(simulation_->events().back(), interface_positions_, scene_.geometry.length, wave_speeds_, frame));
   }
-  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState(simulation_->loadCells(), simulation_->stage().travel());
+  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState(simulation_->loadCells(), stageReading());
   if (due(t, next_lattice_, options_.lattice_rate)) {
     emit(lattice_pub_, "lattice", toMsg(simulation_->snapshot(), frame));
   } else if (ros::WallTime::now() >= next_snapshot_ && lattice_pub_.getNumSubscribers() > 0) {
@@ -388,7 +394,7 @@ void RigSimulator::run() {
       continue;
     }
     if (paused_) {
-      publishStageState(simulation_->loadCells(), simulation_->stage().travel());  // so that a controller learns the time and F_Z while the rig waits
+      publishStageState(simulation_->loadCells(), stageReading());  // so that a controller learns the time and F_Z while the rig waits
       publishClock(simulation_->time());  // nodes on simulated time, and `rostopic echo /clock`, see it stand still
       if (lattice_pub_.getNumSubscribers() > 0) lattice_pub_.publish(toMsg(simulation_->snapshot(), options_.frame_id));
       ros::WallDuration(0.05).sleep();
@@ -400,10 +406,11 @@ void RigSimulator::run() {
     // the curved equilibrium path in straight pieces, so where they were cut would change the run, and
     // the offline runner's run of the same scene and commands is this one, step for step. Paced, it
     // also stops at each interface frame, so that a watcher sees the slider move and a command sent
-    // "now" takes effect within a frame; the events then agree with the unpaced run's to fast-forward's
-    // own error.
+    // "now" takes effect within a frame; its events may then differ from the unpaced run's by
+    // fast-forward's own error. A stage at rest is cut at frames too: nothing moves along its jumps, so
+    // cutting them changes nothing, and with nothing due they would have no end.
     double until = pending_.empty() ? std::numeric_limits<double>::infinity() : pending_.begin()->first;
-    if (options_.real_time_factor > 0.0) until = std::min(until, next_frame_);
+    if (options_.real_time_factor > 0.0 || simulation_->stage().velocity() == 0.0) until = std::min(until, next_frame_);
     const long long jumps = simulation_->jumps();
     // The readings before a possible jump, to interpolate across it; not needed for a plain step.
     const Readings before = simulation_->mayJump() ? readings() : Readings{};
@@ -425,7 +432,7 @@ void RigSimulator::run() {
            << " at t = " << simulation_->time() << " s";
     end_reason = reason.str();
   }
-  publishStageState(simulation_->loadCells(), simulation_->stage().travel());
+  publishStageState(simulation_->loadCells(), stageReading());
   // The summary is the run since the last reset: its simulated time and steps start there, and its wall
   // time is the time spent running since, not waiting paused (for a controller, or a user).
   RunSummary summary = summarize(*simulation_, runningWallTime());

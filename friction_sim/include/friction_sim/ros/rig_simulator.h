@@ -30,11 +30,12 @@
 //                                                  format (also the bag's first message)
 //   applied_commands (friction_msgs/StageCommand)  every command as it took effect, stamped with the
 //                                                  simulated time of the step it took effect at: with the
-//                                                  scene, the bag holds what it takes to run it again
+//                                                  scene, the bag's record of what drove the run
 // Across a fast-forward jump each stream is interpolated on its own grid (the camera at
 // interface_idle_rate): the jump is cut only where a command is due, so that the run is the offline
 // runner's, step for step; paced (real_time_factor > 0) also at every interface frame, so that a watcher
-// sees the slider move and a command sent "now" acts within a frame.
+// sees the slider move and a command sent "now" acts within a frame; and while the stage is at rest,
+// whose jumps move nothing and, with nothing due, would have no end.
 // Subscribed topics:
 //   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time)
 // Services:
@@ -43,7 +44,8 @@
 //                                                  events, a simulated time or a stage travel is reached,
 //                                                  in place of the scene's stop condition and of
 //                                                  ~stop_at_scene_end (a controller's end of its protocol,
-//                                                  so that a run ends where it should however fast it runs)
+//                                                  so that a run ends where it should however fast it runs);
+//                                                  a condition already met is refused (call stop)
 //   pause (std_srvs/SetBool), reset (std_srvs/Trigger), stop (std_srvs/Trigger)
 //   abort (std_srvs/Trigger)                       ends the run as stop does, and the node then exits with
 //                                                  status 4: what drives the run could not (a controller
@@ -54,8 +56,8 @@
 // Exit status: 0 when the run ended (its end, stop, a signal, ROS shut down), 2 when the scene or a
 // parameter is refused, 4 when the run was aborted.
 //
-// Commands with NaN/inf, a normal load <= 0, a speed beyond the scene's stage.max_speed or an unknown
-// mode are refused with a logged reason; the simulation keeps running. A HOLD's speed and target are
+// Commands with NaN/inf, a normal load <= 0 or beyond largestNormalForce (5 % of E over the slider's
+// base), a speed beyond the scene's stage.max_speed or an unknown mode are refused with a logged reason; the simulation keeps running. A HOLD's speed and target are
 // ignored: a hold has none.
 #pragma once
 
@@ -122,21 +124,29 @@ class RigSimulator {
   void advertise();
   void startSimulation();
   void publishInstruments();
+  /// What the stage does at one instant.
+  struct StageReading {
+    StageMode mode = StageMode::Hold;
+    double velocity = 0.0;  ///< m/s
+    double target = 0.0;    ///< m, of a move to a position
+    double travel = 0.0;    ///< m, total distance moved
+  };
+  StageReading stageReading() const;
   /// Every instrument's reading at one instant.
   struct Readings {
     LoadCellReading cells;
     GaugeProfile gauges;  ///< empty for the chain
     InterfaceFrame frame;
     LatticeSnapshot lattice;
-    double stage_travel = 0.0;  ///< m
+    StageReading stage;
   };
   Readings readings() const;
   /// After a fast-forward jump: every instrument's reading at every publication time the jump passed,
   /// interpolated from `before` the jump and after it (along a jump the statics are nearly affine in time).
   void publishAcrossJump(const Readings& before);
   void publishClock(double time);
-  /// The stage state with the load cells' time, position and forces and the stage's `travel` (m) then.
-  void publishStageState(const LoadCellReading& cells, double travel);
+  /// The stage state from the load cells' time, position and forces and what the stage did then.
+  void publishStageState(const LoadCellReading& cells, const StageReading& stage);
   void applyDueCommands();
   std::string accept(const friction_msgs::StageCommand& msg);
   void onCommand(const friction_msgs::StageCommand::ConstPtr& msg);
