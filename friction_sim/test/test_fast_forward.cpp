@@ -95,6 +95,15 @@ TEST(FastForward, AHoldCommandedWhileAThresholdIsApproachedJumpsAgain) {
   EXPECT_GT(simulation.jumps(), jumps);
   EXPECT_LT(simulation.steps() - steps, 10);
   EXPECT_TRUE(simulation.events().empty());
+  // Driven back, then forward again at the approach's speed: the approach is over, and the slider jumps
+  // back towards the threshold rather than stepping all the way (found by a review).
+  simulation.stage().command(StageCommand{StageMode::Velocity, -4e-3, 0.0});
+  simulation.advance(simulation.time() + 0.002);
+  simulation.stage().command(StageCommand{StageMode::Velocity, 4e-3, 0.0});
+  const long long steps_back = simulation.steps(), jumps_back = simulation.jumps();
+  simulation.advance(simulation.time() + 0.001);
+  EXPECT_GT(simulation.jumps(), jumps_back);
+  EXPECT_EQ(simulation.steps(), steps_back);
 }
 
 TEST(FastForward, AStageAtRestWithNoEndTakesNoEndlessJump) {
