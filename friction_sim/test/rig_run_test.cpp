@@ -27,12 +27,15 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
 #include <memory>
+#include <sstream>
 
 #include "friction_sim/loading_protocol.h"
+#include "friction_sim/results_io.h"
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
 #include "friction_sim/scene_io.h"
@@ -520,6 +523,16 @@ TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
     EXPECT_EQ(offline.events()[e].mean_shear_force, g_seen.events[e].mean_shear_force);
     EXPECT_EQ(offline.events()[e].node_slip, g_seen.events[e].node_slip);
   }
+  // rig_report's table from the bag is the offline runner's events.csv, to the last digit.
+  std::ostringstream offline_table;
+  writeEventsCsv(offline_table, offline.events(), offline.scene());
+  const std::string out = "/tmp/" + ros::this_node::getName().substr(1) + "_report";
+  std::string output;
+  ASSERT_EQ(runCommand("rosrun friction_sim rig_report " + g_bag + " --out " + out, output), 0) << output;
+  std::ifstream report(out + "/events.csv");
+  std::stringstream report_table;
+  report_table << report.rdbuf();
+  EXPECT_EQ(report_table.str(), offline_table.str());
 }
 
 TEST(KillRun, BagIsReadableAndHoldsEverythingUpToTheKill) {
