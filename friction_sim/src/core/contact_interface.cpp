@@ -224,8 +224,10 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
           state_[node] == ContactState::Sliding ? friction_[latest_slot_][node] : start_friction_[node];
       const double slip = u[dof] - start_u_[node];
       dissipation_ -= 0.5 * (start_friction_[node] + end_friction) * slip;
+      const double sliding_before = sliding_coefficient_[node];
       addSlip(node, slip);
-      slip_changed_coefficients_ = slip_changed_coefficients_ || !uniform_law_;
+      // Fully weakened (or under a law without slip) the coefficient stays: nothing to apply again.
+      slip_changed_coefficients_ = slip_changed_coefficients_ || sliding_coefficient_[node] != sliding_before;
     }
   }
   for (int node : unstuck_last_step_) just_unstuck_[node] = 0;  // the only nodes flagged
