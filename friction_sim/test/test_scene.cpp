@@ -93,6 +93,9 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"material: {density: -1200}", "material.density: value -1200", "> 0"},
         InvalidCase{"pusher: {stiffness: 0}", "pusher.stiffness: value 0", "> 0"},
         InvalidCase{"lattice: {nodes_x: 57, nodes_z: 30}", "lattice.nodes_z: value 30", "square lattice"},
+        // With the sizes that fit the geometry (found by a new-user walkthrough: which field to change?).
+        InvalidCase{"lattice: {nodes_x: 50}", "lattice.nodes_z: value 31",
+                    "sizes that fit 0.14 m x 0.075 m: nodes_x - 1 a multiple of 28, e.g. nodes_x: 57, nodes_z: 31"},
         InvalidCase{"instruments: {gauge_height: 0.1}", "instruments.gauge_height: value 0.1", "inside the slider"},
         InvalidCase{"integrator: {time_step: 1.0e-5}", "integrator.time_step: value 1e-05",
                     "stability limit of this scene"},

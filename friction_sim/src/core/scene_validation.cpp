@@ -66,6 +66,15 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
       std::ostringstream allowed;
       allowed << "a square lattice: geometry.height/(nodes_z-1) = " << spacing_z
               << " m must equal geometry.length/(nodes_x-1) = " << spacing_x << " m";
+      // The sizes that fit, so that whichever of the two was changed can be matched.
+      for (int intervals_x = 1; intervals_x <= 10000; ++intervals_x) {
+        const double intervals_z = intervals_x * s.geometry.height / s.geometry.length;
+        if (std::abs(intervals_z - std::round(intervals_z)) > 1e-6 * intervals_z || std::round(intervals_z) < 1) continue;
+        allowed << "; sizes that fit " << s.geometry.length << " m x " << s.geometry.height << " m: nodes_x - 1 a multiple of "
+                << intervals_x << ", e.g. nodes_x: " << 2 * intervals_x + 1
+                << ", nodes_z: " << 2 * std::lround(intervals_z) + 1;
+        break;
+      }
       check.require(std::abs(spacing_x - spacing_z) <= 1e-6 * spacing_x, "lattice.nodes_z", s.lattice.nodes_z,
                     allowed.str());
     }
