@@ -27,8 +27,9 @@ class FrameEventDetector {
   /// Interface frames, in time order.
   void addFrame(const InterfaceFrame& frame);
   /// Events that have ended and whose load-cell readings have arrived (the two topics travel
-  /// separately, so the load cells of an event's last step may come after its last frame).
-  std::vector<SlipEvent> takeCompletedEvents();
+  /// separately, so the load cells of an event's last step may come after its last frame); with
+  /// `no_more_readings`, every ended event, from the readings there are (the stream restarts).
+  std::vector<SlipEvent> takeCompletedEvents(bool no_more_readings = false);
   /// Forgets everything (time jumped backwards, e.g. looped playback).
   void reset();
 

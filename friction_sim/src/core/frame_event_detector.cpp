@@ -30,9 +30,11 @@ void FrameEventDetector::addLoadCells(const LoadCellReading& reading) {
   load_cells_.push_back(reading);
 }
 
-std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents() {
+std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents(bool no_more_readings) {
   std::vector<SlipEvent> ready;
-  const double latest = load_cells_.empty() ? -std::numeric_limits<double>::infinity() : load_cells_.back().time;
+  const double latest = no_more_readings     ? std::numeric_limits<double>::infinity()
+                        : load_cells_.empty() ? -std::numeric_limits<double>::infinity()
+                                              : load_cells_.back().time;
   while (!ended_.empty() && ended_.front().end_time <= latest) {
     SlipEvent event = std::move(ended_.front());
     ended_.pop_front();

@@ -65,7 +65,12 @@ void PrecursorDetector::use(const DetectorSettings& settings) {
 }
 
 void PrecursorDetector::onScene(const std_msgs::String::ConstPtr& msg) {
-  // A new detector either way: what the old one saw was measured against another scene, or none. The
+  // The same scene again is a looped bag starting its next pass, ahead of the last frames of this one:
+  // the time jumping back starts the analysis over once they are in (a new detector here lost the last
+  // event on every pass, found by a new-user walkthrough).
+  if (msg->data == scene_text_) return;
+  scene_text_ = msg->data;
+  // A new detector otherwise: what the old one saw was measured against another scene, or none. The
   // scene is its bag's first message, but it travels apart from the frames, which may come first.
   if (frames_seen_ > 0) {
     ROS_WARN_STREAM("precursor detector: the run's scene came after " << frames_seen_
@@ -87,6 +92,9 @@ void PrecursorDetector::checkTime(const ros::Time& stamp) {
   // Seconds, not ros::Time: near t = 0 the margin would underflow ros::Time's unsigned range.
   if (stamp.toSec() < last_stamp_.toSec() - 1e-3) {
     ROS_WARN_STREAM("precursor detector: time jumped back to " << stamp.toSec() << " s; starting over");
+    // An event that ended on the last frames (a run's last) may still wait for a load-cell reading that,
+    // on its own topic, comes after the next pass has begun: published from the readings there are.
+    publishCompleted(true);
     detector_->reset();
   }
   last_stamp_ = stamp;
@@ -106,8 +114,8 @@ void PrecursorDetector::onFrame(const friction_msgs::InterfaceState::ConstPtr& m
   publishCompleted();
 }
 
-void PrecursorDetector::publishCompleted() {
-  for (const SlipEvent& event : detector_->takeCompletedEvents()) {
+void PrecursorDetector::publishCompleted(bool no_more_readings) {
+  for (const SlipEvent& event : detector_->takeCompletedEvents(no_more_readings)) {
     const double length = detector_->sliderLength();
     events_pub_.publish(toMsg(event, positions_, length, wave_speeds_, frame_id_));
     points_pub_.publish(toPointMsg(event, length, frame_id_));

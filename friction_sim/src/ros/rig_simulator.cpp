@@ -410,7 +410,10 @@ void RigSimulator::run() {
     // fast-forward's own error. A stage at rest is cut at frames too: nothing moves along its jumps, so
     // cutting them changes nothing, and with nothing due they would have no end.
     double until = pending_.empty() ? std::numeric_limits<double>::infinity() : pending_.begin()->first;
-    if (options_.real_time_factor > 0.0 || simulation_->stage().velocity() == 0.0) until = std::min(until, next_frame_);
+    // A frame within a step of the command is no cut: the jump would stop a hair short of it, and the
+    // step after would pass it (the command applied a step late, found by a new-user walkthrough).
+    const bool cut_at_frames = options_.real_time_factor > 0.0 || simulation_->stage().velocity() == 0.0;
+    if (cut_at_frames && next_frame_ < until - simulation_->timeStep()) until = next_frame_;
     const long long jumps = simulation_->jumps();
     // The readings before a possible jump, to interpolate across it; not needed for a plain step.
     const Readings before = simulation_->mayJump() ? readings() : Readings{};

@@ -72,7 +72,8 @@ class PrecursorDetector {
   void checkTime(const ros::Time& stamp);
   void use(const DetectorSettings& settings);
   void onScene(const std_msgs::String::ConstPtr& msg);
-  void publishCompleted();
+  /// `no_more_readings`: as FrameEventDetector::takeCompletedEvents.
+  void publishCompleted(bool no_more_readings = false);
 
   ros::NodeHandle nh_, private_nh_;
   std::unique_ptr<FrameEventDetector> detector_;
@@ -81,6 +82,7 @@ class PrecursorDetector {
   std::vector<double> positions_;
   std::string frame_id_;  ///< the interface frames', for the events
   long frames_seen_ = 0;  ///< interface frames since the analysis last started over
+  std::string scene_text_;  ///< the scene in use, as received
   ros::Time last_stamp_;
   ros::Subscriber load_cells_sub_, interface_sub_, scene_sub_;
   ros::Publisher events_pub_, points_pub_;
