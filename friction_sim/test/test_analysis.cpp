@@ -75,6 +75,28 @@ TEST(LoadingProtocol, BadProtocolListsEveryProblem) {
   }
 }
 
+TEST(LoadingProtocol, WhatAStepActsWithAndAnEndMustBeGiven) {
+  // A move_to without its target drove the stage back to 0, and a protocol without an end ran (and
+  // recorded) until stopped (found by a new-user walkthrough). Each missing field is named once, not
+  // also by its default's value.
+  try {
+    parseProtocol(
+        "steps:\n"
+        "  - {action: move_to, speed: 1.0e-3, duration: 0.05}\n"
+        "  - {action: drive, duration: 0.1}\n"
+        "  - {action: normal_load, ramp_time: 0.01}\n"
+        "  - {action: hold, duration: .inf}\n");
+    FAIL() << "accepted";
+  } catch (const ConfigError& error) {
+    const std::string text = error.what();
+    EXPECT_EQ(error.problems().size(), 4u) << text;
+    EXPECT_NE(text.find("steps[0].target: not given; needed: the stage position to move to, m"), std::string::npos) << text;
+    EXPECT_NE(text.find("steps[1].speed: not given; needed: the stage's speed, m/s"), std::string::npos) << text;
+    EXPECT_NE(text.find("steps[2].normal_force: not given; needed: the F_Z to reach, N"), std::string::npos) << text;
+    EXPECT_NE(text.find("end: no condition, so the run would never end"), std::string::npos) << text;
+  }
+}
+
 TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
   // Nodes 0–2 (2.5 mm apart) unstick together; a front then runs at 600 m/s up to node 10; node 11 holds.
   const double spacing = 0.0025, speed = 600.0;

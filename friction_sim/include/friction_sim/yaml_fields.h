@@ -67,6 +67,13 @@ class YamlFieldReader {
     read(child, path(key), value);
   }
 
+  /// Reports `key` if the current mapping lacks it (`what` says what it is for); false then.
+  bool require(const char* key, const std::string& what) {
+    if (node_[key]) return true;
+    problems_.push_back(path(key) + ": not given; needed: " + what);
+    return false;
+  }
+
   void section(const char* key, const std::function<void()>& body) {
     used_.insert(key);
     const YAML::Node child = node_[key];

@@ -1,6 +1,8 @@
 #include "friction_sim/loading_protocol.h"
 
 #include <cmath>
+#include <set>
+#include <string>
 
 #include "friction_sim/yaml_fields.h"
 
@@ -22,10 +24,24 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
   // A step whose action was refused has no rules to check its other keys by: they would blame fields
   // the user never wrote.
   std::vector<bool> action_refused;
+  std::set<std::string> missing;  // fields not given: their defaults' values are not refused again below
   reader.list("steps", protocol.steps, [&](ProtocolStep& step) {
+    const std::string where = "steps[" + std::to_string(action_refused.size()) + "].";
+    auto require = [&](const char* key, const std::string& what) {
+      if (!reader.require(key, what)) missing.insert(where + key);
+    };
     const std::size_t problems_before = problems.size();
     reader.field("action", step.action);
     action_refused.push_back(problems.size() > problems_before);
+    // No default stands in for what a step acts with: a move_to without its target drove the stage
+    // back to 0 and unloaded the slider (found by a new-user walkthrough).
+    if (!action_refused.back()) {
+      if (step.action == ProtocolAction::NormalLoad) require("normal_force", "the F_Z to reach, N");
+      if (step.action == ProtocolAction::Drive || step.action == ProtocolAction::MoveTo) {
+        require("speed", "the stage's speed, m/s");
+      }
+      if (step.action == ProtocolAction::MoveTo) require("target", "the stage position to move to, m");
+    }
     reader.field("normal_force", step.normal_force);
     reader.field("ramp_time", step.ramp_time);
     reader.field("speed", step.speed);
@@ -41,7 +57,7 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
   reader.rejectUnknownKeys();
 
   auto problem = [&](const std::string& field, double value, const std::string& allowed) {
-    requireSetting(false, field, value, allowed, problems);
+    if (!missing.count(field)) requireSetting(false, field, value, allowed, problems);
   };
   for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
     const ProtocolStep& step = protocol.steps[i];
@@ -63,6 +79,10 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
   if (!(protocol.end.stage_travel > 0.0)) problem("end.stage_travel", protocol.end.stage_travel, "a travel > 0 m");
   if (!(protocol.end.time > 0.0)) problem("end.time", protocol.end.time, "a time > 0 s");
   if (protocol.ramp_commands < 1) problem("ramp_commands", protocol.ramp_commands, "an integer >= 1");
+  if (protocol.end.global_events == 0 && std::isinf(protocol.end.stage_travel) && std::isinf(protocol.end.time)) {
+    problems.push_back("end: no condition, so the run would never end (a recording one would fill the disk); give "
+                       "global_events, stage_travel or time");
+  }
   if (!problems.empty()) throw ConfigError("protocol", problems);
   return protocol;
 }
