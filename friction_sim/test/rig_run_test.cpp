@@ -560,8 +560,10 @@ void watchFullRun(ros::NodeHandle& nh) {
                                                                 ++g_seen.lattice_snapshots;
                                                                 g_seen.last_lattice = *m;
                                                               }));
-  // While the rig runs: bad commands, then a bad scene and a bad parameter for a second simulator.
-  waitFor([] { return g_seen.last_stage_time > 1e-3; }, 60.0);
+  // Bad commands to the rig while it waits for its controller (5 s here: with fast-forward the run itself
+  // is over in a tenth of a second, and calls made while it ran could come after it had ended); then a
+  // bad scene and a bad parameter for a second simulator.
+  ros::service::waitForService("/rig/send_command", ros::Duration(60.0));
   ros::ServiceClient client = nh.serviceClient<friction_msgs::SendStageCommand>("/rig/send_command");
   for (auto [mode, speed, load] : {std::tuple<int, double, double>{0, std::nan(""), 0.0},
                                    std::tuple<int, double, double>{3, 0.0, -5.0},
