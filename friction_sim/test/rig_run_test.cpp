@@ -119,6 +119,14 @@ class StandInSimulator {
       return true;
     });
   }
+  /// Accepts every call to its service `name` (send_command, set_run_end), counting them in `calls`.
+  template <class Service>
+  void acceptCalls(const std::string& name, int& calls) {
+    answer<Service>(name, [&calls](typename Service::Request&, typename Service::Response& response) {
+      ++calls;
+      response.accepted = true;
+    });
+  }
   /// Counts the calls to its Trigger service `name` (stop, abort) in `calls`.
   void countCalls(const std::string& name, int& calls) {
     answer<std_srvs::Trigger>(name, [&calls](std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
@@ -192,16 +200,8 @@ void runProtocolAgainstARefusingSimulator(const std::string& protocol) {
 /// count of resets alone shows it), then, unpaused again, the protocol's end (two global events).
 void runControllerThroughAResetAtTheStart(const std::string& protocol) {
   StandInSimulator simulator("/reset_at_start");
-  simulator.answer<friction_msgs::SendStageCommand>(
-      "send_command", [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
-        ++g_seen.commands_around_reset;
-        response.accepted = true;
-      });
-  simulator.answer<friction_msgs::SetRunEnd>(
-      "set_run_end", [](friction_msgs::SetRunEnd::Request&, friction_msgs::SetRunEnd::Response& response) {
-        ++g_seen.run_ends_around_reset;
-        response.accepted = true;
-      });
+  simulator.acceptCalls<friction_msgs::SendStageCommand>("send_command", g_seen.commands_around_reset);
+  simulator.acceptCalls<friction_msgs::SetRunEnd>("set_run_end", g_seen.run_ends_around_reset);
   simulator.answer<std_srvs::SetBool>(
       "pause", [&simulator](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
         if (!request.data && ++g_seen.unpauses_around_reset == 1) simulator.announce(1, 0.0, 0, true);
@@ -215,16 +215,14 @@ void runControllerThroughAResetAtTheStart(const std::string& protocol) {
 /// A controller whose simulator fails the first send_command call (as a lost connection would) and
 /// takes every other command, then announces the protocol's end when unpaused.
 void runControllerThroughAFailedCall(const std::string& protocol) {
+  int run_ends = 0;  // outlives the stand-in's services
   StandInSimulator simulator("/failed_call");
   simulator.serve<friction_msgs::SendStageCommand>(
       "send_command", [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
         response.accepted = true;
         return ++g_seen.commands_with_a_failed_call > 1;
       });
-  simulator.answer<friction_msgs::SetRunEnd>(
-      "set_run_end", [](friction_msgs::SetRunEnd::Request&, friction_msgs::SetRunEnd::Response& response) {
-        response.accepted = true;
-      });
+  simulator.acceptCalls<friction_msgs::SetRunEnd>("set_run_end", run_ends);
   simulator.answer<std_srvs::SetBool>(
       "pause", [&simulator](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
         if (!request.data) simulator.announce(0, 0.1, 2, false);

@@ -106,14 +106,11 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
     }
     current_.nucleation_position = sum / count;
   }
-  const auto detached = static_cast<std::size_t>(
-      std::count(frame.state.begin(), frame.state.end(), static_cast<std::uint8_t>(ContactState::Detached)));
-  in_contact_.note(detached, [&frame](std::size_t node) { return static_cast<ContactState>(frame.state[node]); });
   for (std::size_t node = 0; node < n; ++node) {
+    if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Detached)) in_contact_.touch(node);
     if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) &&
         std::isnan(current_.first_unstick_time[node])) {
       current_.first_unstick_time[node] = frame.time;
-      in_contact_.touch(node);
     }
   }
   if (sliding) return;

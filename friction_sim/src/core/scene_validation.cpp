@@ -63,11 +63,12 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
     if (s.lattice.nodes_x >= 2 && s.lattice.nodes_z >= 2 && s.geometry.length > 0 && s.geometry.height > 0) {
       const double spacing_x = s.geometry.length / (s.lattice.nodes_x - 1);
       const double spacing_z = s.geometry.height / (s.lattice.nodes_z - 1);
+      const bool square = std::abs(spacing_x - spacing_z) <= 1e-6 * spacing_x;
       std::ostringstream allowed;
       allowed << "a square lattice: geometry.height/(nodes_z-1) = " << spacing_z
               << " m must equal geometry.length/(nodes_x-1) = " << spacing_x << " m";
       // The sizes that fit, so that whichever of the two was changed can be matched.
-      for (int intervals_x = 1; intervals_x <= 10000; ++intervals_x) {
+      for (int intervals_x = 1; !square && intervals_x <= 10000; ++intervals_x) {
         const double intervals_z = intervals_x * s.geometry.height / s.geometry.length;
         if (std::abs(intervals_z - std::round(intervals_z)) > 1e-6 * intervals_z || std::round(intervals_z) < 1) continue;
         allowed << "; sizes that fit " << s.geometry.length << " m x " << s.geometry.height << " m: nodes_x - 1 a multiple of "
@@ -75,8 +76,7 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
                 << ", nodes_z: " << 2 * std::lround(intervals_z) + 1;
         break;
       }
-      check.require(std::abs(spacing_x - spacing_z) <= 1e-6 * spacing_x, "lattice.nodes_z", s.lattice.nodes_z,
-                    allowed.str());
+      check.require(square, "lattice.nodes_z", s.lattice.nodes_z, allowed.str());
     }
     check.positive("lattice.foundation_ratio", s.lattice.foundation_ratio);
     check.within("instruments.gauge_height", s.instruments.gauge_height, 0.0, s.geometry.height,

@@ -179,6 +179,8 @@ void RigSimulator::publishClock(double time) {
   clock_pub_.publish(clock);
 }
 
+void RigSimulator::publishStageState() { publishStageState(simulation_->loadCells(), stageReading()); }
+
 RigSimulator::StageReading RigSimulator::stageReading() const {
   const Stage& stage = simulation_->stage();
   return {stage.current().mode, stage.velocity(), stage.current().target, stage.travel()};
@@ -260,7 +262,7 @@ void RigSimulator::publishInstruments() {
     emit(events_pub_, "slip_events",
          toMsg(simulation_->events().back(), interface_positions_, scene_.geometry.length, wave_speeds_, frame));
   }
-  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState(simulation_->loadCells(), stageReading());
+  if (due(t, next_stage_state_, options_.stage_state_rate)) publishStageState();
   if (due(t, next_lattice_, options_.lattice_rate)) {
     emit(lattice_pub_, "lattice", toMsg(simulation_->snapshot(), frame));
   } else if (ros::WallTime::now() >= next_snapshot_ && lattice_pub_.getNumSubscribers() > 0) {
@@ -394,7 +396,7 @@ void RigSimulator::run() {
       continue;
     }
     if (paused_) {
-      publishStageState(simulation_->loadCells(), stageReading());  // so that a controller learns the time and F_Z while the rig waits
+      publishStageState();  // so that a controller learns the time and F_Z while the rig waits
       publishClock(simulation_->time());  // nodes on simulated time, and `rostopic echo /clock`, see it stand still
       if (lattice_pub_.getNumSubscribers() > 0) lattice_pub_.publish(toMsg(simulation_->snapshot(), options_.frame_id));
       ros::WallDuration(0.05).sleep();
@@ -435,7 +437,7 @@ void RigSimulator::run() {
            << " at t = " << simulation_->time() << " s";
     end_reason = reason.str();
   }
-  publishStageState(simulation_->loadCells(), stageReading());
+  publishStageState();
   // The summary is the run since the last reset: its simulated time and steps start there, and its wall
   // time is the time spent running since, not waiting paused (for a controller, or a user).
   RunSummary summary = summarize(*simulation_, runningWallTime());

@@ -147,6 +147,8 @@ class RigSimulator {
   void publishClock(double time);
   /// The stage state from the load cells' time, position and forces and what the stage did then.
   void publishStageState(const LoadCellReading& cells, const StageReading& stage);
+  /// The stage state now.
+  void publishStageState();
   void applyDueCommands();
   std::string accept(const friction_msgs::StageCommand& msg);
   void onCommand(const friction_msgs::StageCommand::ConstPtr& msg);
