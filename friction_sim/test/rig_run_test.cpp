@@ -81,6 +81,14 @@ int runCommand(const std::string& command, std::string& output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+/// The whole text of a file ("" if it cannot be read).
+std::string readFile(const std::string& path) {
+  std::ifstream file(path);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
 bool waitFor(const std::function<bool()>& condition, double seconds) {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
   while (ros::ok() && ros::WallTime::now() < deadline) {
@@ -434,12 +442,16 @@ TEST(FullRun, BagHoldsEverySlipEventAndEveryInterfaceFrame) {
   checkBagHasEveryEventAndNoFrameGap(g_seen.events);
 }
 
-TEST(FullRun, BagHoldsTheSceneAsRunFirst) {
+TEST(FullRun, BagHoldsTheSceneAsRunFirstAndAgainWithTheProtocolsEnd) {
   ASSERT_TRUE(bagReadable(g_bag)) << g_bag;
   const auto scenes = readTopic<std_msgs::String>(g_bag, "/rig/scene");
-  ASSERT_EQ(scenes.size(), 1u);
-  // The recorded text reads back as the scene the launch named, its overrides applied, field for field.
-  EXPECT_EQ(sceneToYaml(parseScene(scenes[0]->data)), sceneToYaml(launchedScene()));
+  ASSERT_EQ(scenes.size(), 2u);
+  // The recorded text reads back as the scene the launch named, its overrides applied, field for field;
+  // then with the end the controller set (two_global_events.yaml) as its stop condition.
+  Scene as_run = launchedScene();
+  EXPECT_EQ(sceneToYaml(parseScene(scenes[0]->data)), sceneToYaml(as_run));
+  as_run.stop = StopSpec{2, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  EXPECT_EQ(sceneToYaml(parseScene(scenes[1]->data)), sceneToYaml(as_run));
   rosbag::Bag bag(g_bag);
   rosbag::View everything(bag);
   ASSERT_GT(everything.size(), 0u);
@@ -527,10 +539,13 @@ TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
   const std::string out = "/tmp/" + ros::this_node::getName().substr(1) + "_report";
   std::string output;
   ASSERT_EQ(runCommand("rosrun friction_sim rig_report " + g_bag + " --out " + out, output), 0) << output;
-  std::ifstream report(out + "/events.csv");
-  std::stringstream report_table;
-  report_table << report.rdbuf();
-  EXPECT_EQ(report_table.str(), offline_table.str());
+  EXPECT_EQ(readFile(out + "/events.csv"), offline_table.str());
+  // And the offline runner, given the scene and the commands rig_report wrote from the bag (the command
+  // it prints), reruns the live run to the last digit.
+  const std::string arguments = out + "/scene.yaml --commands " + out + "/stage_commands.csv --out " + out + "/rerun";
+  EXPECT_NE(output.find("/friction_run " + arguments), std::string::npos) << output;
+  ASSERT_EQ(runCommand("rosrun friction_sim friction_run " + arguments, output), 0) << output;
+  EXPECT_EQ(readFile(out + "/rerun/events.csv"), offline_table.str());
 }
 
 TEST(KillRun, BagIsReadableAndHoldsEverythingUpToTheKill) {

@@ -94,6 +94,91 @@ TEST(LoadingProtocol, WhatAStepActsWithAndAnEndMustBeGiven) {
        "end: no condition, so the run would never end"});
 }
 
+TEST(CommandTable, ReadsEachCommandWithTheTimeTheRigComparedItsClockWith) {
+  const auto commands = parseCommandTable(
+      "time_s,command,speed_m_s,target_m,normal_force_N\n"
+      "0.000000000,hold,,,\n"
+      "0.130000200,velocity,-0.0004,,\n"
+      "0.2,position,0.001,1.5e-4,\n"
+      "1.000000001,normal_load,,,2500\n");
+  ASSERT_EQ(commands.size(), 4u);
+  EXPECT_EQ(commands[0].kind, TimedCommand::Kind::Stage);
+  EXPECT_EQ(commands[0].stage.mode, StageMode::Hold);
+  EXPECT_EQ(commands[0].time, 0.0);
+  EXPECT_EQ(commands[1].stage.mode, StageMode::Velocity);
+  EXPECT_EQ(commands[1].stage.speed, -4e-4);
+  // Whole seconds plus nanoseconds, summed as ros::Time::toSec() sums a stamp's: the double the rig
+  // compared its clock with, which the nearest double to the decimal text need not be.
+  EXPECT_EQ(commands[1].time, 0.0 + 1e-9 * 130000200.0);
+  EXPECT_EQ(commands[2].stage.mode, StageMode::Position);
+  EXPECT_EQ(commands[2].stage.speed, 1e-3);
+  EXPECT_EQ(commands[2].stage.target, 1.5e-4);
+  EXPECT_EQ(commands[2].time, 0.0 + 1e-9 * 200000000.0);
+  EXPECT_EQ(commands[3].kind, TimedCommand::Kind::NormalLoad);
+  EXPECT_EQ(commands[3].normal_force, 2500.0);
+  EXPECT_EQ(commands[3].time, 1.0 + 1e-9 * 1.0);
+}
+
+TEST(CommandTable, BadTableListsEveryProblemWithItsLine) {
+  try {
+    parseCommandTable(
+        "time_s,command,speed_m_s,target_m,normal_force_N\n"
+        "0.1,hold,0.0004,,\n"
+        "0.05,velocity,,,\n"
+        "-1,jump,,,\n"
+        "0.2,position,0.001\n"
+        "inf,normal_load,,,abc\n",
+        "run/stage_commands.csv");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& error) {
+    const std::string text = error.what();
+    const std::vector<std::string> problems{
+        "run/stage_commands.csv, line 2: hold takes no speed_m_s, got '0.0004'; leave it empty",
+        "run/stage_commands.csv, line 3: time_s 0.05 is earlier than the row before; allowed: rows in time order",
+        "run/stage_commands.csv, line 3: velocity needs speed_m_s as a number, got ''",
+        "run/stage_commands.csv, line 4: time_s '-1' is not allowed; allowed: a finite time >= 0 s",
+        "run/stage_commands.csv, line 4: command 'jump' is unknown; allowed: velocity, hold, position, normal_load",
+        "run/stage_commands.csv, line 5: 5 fields expected (time_s, command, speed_m_s, target_m, normal_force_N), "
+        "got 3",
+        "run/stage_commands.csv, line 6: time_s 'inf' is not allowed",
+        "run/stage_commands.csv, line 6: normal_load needs normal_force_N as a number, got 'abc'"};
+    EXPECT_EQ(error.problems().size(), problems.size()) << text;
+    for (const std::string& problem : problems) EXPECT_NE(text.find(problem), std::string::npos) << problem << "\n" << text;
+  }
+  try {
+    parseCommandTable("time,mode\n0,hold\n");
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& error) {
+    EXPECT_NE(std::string(error.what()).find("line 1: the header must be 'time_s,command,speed_m_s,target_m,"
+                                             "normal_force_N', got 'time,mode'"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
+TEST(CommandTable, ARunRefusesWhatItsSceneRefusesAndAppliesTheRest) {
+  Scene scene;
+  scene.model = ModelKind::Chain1D;
+  scene.chain.blocks = 1;
+  Simulation simulation(scene);
+  const auto commands = parseCommandTable(
+      "time_s,command,speed_m_s,target_m,normal_force_N\n"
+      "0,velocity,2.0,,\n"       // beyond stage.max_speed, 1 m/s
+      "0,normal_load,,,-5\n"     // F_Z must be > 0
+      "0,normal_load,,,2500\n"
+      "0,position,0.001,2e-4,\n");
+  EXPECT_NE(simulation.checkCommand(commands[0]).find("exceeds the stage's max_speed"), std::string::npos);
+  EXPECT_NE(simulation.checkCommand(commands[1]).find("normal load -5 N is not allowed"), std::string::npos);
+  EXPECT_EQ(simulation.checkCommand(commands[2]), "");
+  EXPECT_NE(simulation.apply(commands[0]), "");
+  EXPECT_EQ(simulation.stage().current().speed, scene.stage.program[0].speed);  // unchanged
+  EXPECT_EQ(simulation.apply(commands[2]), "");
+  EXPECT_EQ(simulation.loadCells().normal_force, 2500.0);
+  EXPECT_EQ(simulation.apply(commands[3]), "");
+  EXPECT_EQ(simulation.stage().current().mode, StageMode::Position);
+  EXPECT_EQ(simulation.stage().current().target, 2e-4);
+}
+
 TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
   // Nodes 0–2 (2.5 mm apart) unstick together; a front then runs at 600 m/s up to node 10; node 11 holds.
   const double spacing = 0.0025, speed = 600.0;

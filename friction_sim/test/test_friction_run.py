@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """The offline runner's command line: an argument it cannot read is refused with exit status 2, a bad
-override of a scene field with 3, an output directory it cannot write with 4, each before anything runs,
-with a message that says what is wrong, and no results directory is written."""
+override of a scene field or a bad command table with 3, an output directory it cannot write with 4, each
+before anything runs, with a message that says what is wrong, and no results directory is written; and a
+command table drives the run as the rig's commands do."""
+import csv
 import os
 import shutil
 import subprocess
@@ -50,7 +52,7 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertIn("unknown argument '--sett'", message)
 
     def test_an_option_missing_its_value_is_named(self):
-        for option in ["--set", "--out"]:
+        for option in ["--set", "--out", "--commands"]:
             status, message = self.refusal(SCENE, option)
             self.assertEqual(status, 2, option)
             self.assertIn("%s needs a value" % option, message)
@@ -68,6 +70,44 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         status, message = self.refusal(SCENE, "--out", self.out)
         self.assertEqual(status, 4)
         self.assertIn("--out %s: cannot create the directory" % self.out, message)
+
+    def commands(self, rows):
+        """A command table of `rows` in the work folder; returns its path."""
+        path = os.path.join(self.work, "commands.csv")
+        with open(path, "w") as table:
+            table.write("time_s,command,speed_m_s,target_m,normal_force_N\n" + "".join(row + "\n" for row in rows))
+        return path
+
+    def test_a_bad_command_table_lists_every_problem_before_the_run(self):
+        table = self.commands(["0,hold,,,", "0.1,velocity,fast,,"])
+        status, message = self.refusal(SCENE, "--out", self.out, "--commands", table)
+        self.assertEqual(status, 3)
+        self.assertIn("command table refused (1 problem)", message)
+        self.assertIn("%s, line 3: velocity needs speed_m_s as a number, got 'fast'" % table, message)
+        # What the scene refuses: a speed beyond its stage.max_speed (1 m/s), F_Z beyond 5 % of E over the base.
+        table = self.commands(["0,velocity,2.0,,", "0.1,normal_load,,,1e9"])
+        status, message = self.refusal(SCENE, "--out", self.out, "--commands", table)
+        self.assertEqual(status, 3)
+        self.assertIn("command table refused (2 problems)", message)
+        self.assertIn("command 1 (t = 0.000000 s): speed 2 m/s exceeds the stage's max_speed 1 m/s", message)
+        self.assertIn("command 2 (t = 0.100000 s): normal load 1e+09 N is not allowed", message)
+        status, message = self.refusal(SCENE, "--out", self.out, "--commands", os.path.join(self.work, "none.csv"))
+        self.assertEqual(status, 3)
+        self.assertIn("file '%s' cannot be read" % os.path.join(self.work, "none.csv"), message)
+
+    def test_commands_drive_the_stage_and_the_normal_load(self):
+        # The single block held while F_Z goes from 1920 to 2500 N, then driven at V = 0.4 mm/s from
+        # t0 = 0.1 s: it slips first when K·V·(t − t0) = µ_s·F_Z, at t = 0.1 + 0.4 · 2500 / (4e6 · 4e-4)
+        # = 0.725 s (0.48 s without the commands).
+        table = self.commands(["0,hold,,,", "0.05,normal_load,,,2500", "0.1,velocity,4.0e-4,,"])
+        done = subprocess.run([self.runner, SCENE, "--out", self.out, "--commands", table, "--set",
+                               "stop.global_events=1"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(self.out, "events.csv")) as events:
+            first = next(csv.DictReader(events))
+        self.assertAlmostEqual(float(first["onset_time_s"]), 0.725, delta=2e-6)  # dt = 1 µs
+        self.assertAlmostEqual(float(first["onset_normal_force_N"]), 2500.0, places=9)
+        self.assertAlmostEqual(float(first["shear_ratio"]), 0.4, delta=1e-5)
 
 
 if __name__ == "__main__":

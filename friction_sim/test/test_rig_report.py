@@ -34,11 +34,11 @@ def event(index, onset, shear_ratio, rupture_length, slider_length=0.14):
 
 
 def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None, normal_load_rise=0.0,
-              commands=True):
+              commands=True, scene_again=None):
     """Load cells and frames for 0.1 s (F_Z rising by `normal_load_rise` N per ms), two events from the
     simulator and, unless not `detector`, the same two, with the detector's slightly later reading of F_X,
     from the detector; `also` another rig's namespace with the same; unless not `commands`, a drive and a
-    normal-load command as applied."""
+    normal-load command as applied; `scene_again` a second scene message (the rig's with its run end)."""
     if also:
         write_bag(path + ".also", also, detector, slider_length)
     with rosbag.Bag(path, "w") as bag:
@@ -47,6 +47,8 @@ def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=No
                 for topic, msg, stamp in other.read_messages():
                     bag.write(topic, msg, stamp)
         bag.write(namespace + "/scene", String(data=SCENE), rospy.Time(0, 1))
+        if scene_again:
+            bag.write(namespace + "/scene", String(data=scene_again), rospy.Time(0, 2))
         if commands:
             drive = StageCommand(mode=StageCommand.VELOCITY, speed=4e-4, target=0.5, normal_force=7.0)
             bag.write(namespace + "/applied_commands", drive, rospy.Time(0, 2))
@@ -106,6 +108,21 @@ class RigReportTest(unittest.TestCase):
                 ["time_s", "command", "speed_m_s", "target_m", "normal_force_N"],
                 ["0.000000000", "velocity", "0.0004", "", ""],
                 ["0.050000000", "normal_load", "", "", "2500.0"]])
+        # And the command that reruns the run from the two.
+        self.assertIn("friction_run {0}/scene.yaml --commands {0}/stage_commands.csv --out {0}/rerun".format(self.work),
+                      done.stdout)
+
+    def test_the_scene_is_the_last_recorded_and_a_bag_without_commands_says_so(self):
+        # The rig records its scene again with the run's end when a controller sets it.
+        with_end = SCENE + "stop: {global_events: 4, time: .inf}\n"
+        write_bag(self.bag, commands=False, scene_again=with_end)
+        done = self.report()
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(self.work, "scene.yaml")) as scene:
+            self.assertEqual(scene.read(), with_end)
+        self.assertFalse(os.path.exists(os.path.join(self.work, "stage_commands.csv")))
+        self.assertIn("the bag has no applied_commands topic: no stage_commands.csv", done.stdout)
+        self.assertIn("friction_run {0}/scene.yaml --out {0}/rerun".format(self.work), done.stdout)
 
     def test_the_detectors_events_on_request(self):
         done = self.report("--events", "detector")

@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "friction_sim/integrator.h"
 #include "friction_sim/scene_io.h"
@@ -45,9 +47,15 @@ TEST(SceneFiles, ShippedScenesLoadWithTheirNumbers) {
 }
 
 TEST(SceneFiles, WrittenSceneReadsBackIdentically) {
-  const Scene scene = loadScene(scenePath("pmma_2d"));
+  Scene scene = loadScene(scenePath("pmma_2d"));
   const std::string text = sceneToYaml(scene);
   EXPECT_EQ(sceneToYaml(parseScene(text)), text);
+  // Also with a run end set_run_end gave (the rig records its scene so): no time limit.
+  scene.stop = StopSpec{4, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  const Scene read_back = parseScene(sceneToYaml(scene));
+  EXPECT_EQ(read_back.stop.global_events, 4);
+  EXPECT_TRUE(std::isinf(read_back.stop.time));
+  EXPECT_TRUE(std::isinf(read_back.stop.stage_travel));
 }
 
 TEST(SceneFiles, OverridesAreParsedAndValidatedLikeTheFile) {
@@ -126,6 +134,10 @@ INSTANTIATE_TEST_SUITE_P(
         // 10⁶ N on pmma_2d compressed it by 40 %, folded the lattice and filled the run with NaN.
         InvalidCase{"load: {normal_force: 1.0e6}", "load.normal_force: value 1000000",
                     "at most 126000 N (a mean normal stress F_Z/(L*B) of 5 % of E"},
+        // A run that would never end (found when the rig's scene with its run end had to be a scene).
+        InvalidCase{"stop: {global_events: 0, time: .inf}", "stop: no condition, so the run would never end",
+                    "give global_events, time or stage_travel"},
+        InvalidCase{"stop: {time: 0}", "stop.time: value 0", "a time > 0 s (.inf allowed)"},
         // µ_s·F_Z/3 = 256 N per block: the first would slide at t = 0.
         InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [400.0, 0.0, 0.0]}",
                     "chain.initial_shear[0]: value 400", "|f| <= mu_s * w_0 = 256 N, the block's static threshold"}));

@@ -63,6 +63,21 @@ LoadingProtocol loadProtocol(const std::string& path);
 std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, double start_time,
                                            double start_normal_force);
 
+/// The commands of a command table, as rig_report writes a bag's applied commands (stage_commands.csv)
+/// for friction_run --commands:
+///
+///   time_s,command,speed_m_s,target_m,normal_force_N
+///   0.000000000,hold,,,
+///   0.005000000,velocity,0.0004,,
+///   0.010000000,position,0.0004,0.00012,
+///   0.012000000,normal_load,,,2500
+///
+/// One row per command, in time order (s, simulated); `command` is velocity (speed), hold, position
+/// (speed, target) or normal_load (normal_force), and the fields its mode does not use stay empty.
+/// Throws ConfigError listing every problem with its line.
+std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source = "");
+std::vector<TimedCommand> loadCommandTable(const std::string& path);
+
 /// True once an end condition of the protocol holds.
 bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time);
 

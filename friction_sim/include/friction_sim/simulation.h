@@ -14,6 +14,7 @@
 #include "friction_sim/contact_interface.h"
 #include "friction_sim/instruments.h"
 #include "friction_sim/integrator.h"
+#include "friction_sim/loading_protocol.h"
 #include "friction_sim/model.h"
 #include "friction_sim/scene.h"
 #include "friction_sim/slip_events.h"
@@ -93,6 +94,11 @@ class Simulation : public Dynamics {
   /// Why F_Z = `normal_force` (N) cannot be set now (empty if it can): it must be finite and > 0, and
   /// the spring mattress's plate is placed once, when F_Z is first applied.
   std::string checkNormalLoad(double normal_force) const;
+  /// Why `command` would be refused now (empty if acceptable): the stage's checks, or checkNormalLoad.
+  std::string checkCommand(const TimedCommand& command) const;
+  /// Applies `command` now, whatever its time (the caller applies each when it is due); returns the
+  /// refusal reason, or empty.
+  std::string apply(const TimedCommand& command);
   /// Replaces the scene's stop condition for the rest of the run (a controller's end of its protocol);
   /// finished() is then that condition's. Returns the refusal reason, its problems separated by " | ", or
   /// empty: global_events ≥ 0, time and stage_travel > 0 (∞ allowed).

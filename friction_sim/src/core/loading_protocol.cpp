@@ -1,7 +1,10 @@
 #include "friction_sim/loading_protocol.h"
 
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "friction_sim/yaml_fields.h"
@@ -139,6 +142,122 @@ std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, doub
     time += step.duration;
   }
   return schedule;
+}
+
+namespace {
+
+constexpr const char* kCommandTableHeader = "time_s,command,speed_m_s,target_m,normal_force_N";
+
+/// A number that fills all of `text` (C syntax, inf and nan included).
+bool readNumber(const std::string& text, double& value) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size();
+}
+
+/// A time in seconds. Written with at most nine decimals, as rig_report writes a bag's stamps, it is
+/// read as whole seconds and nanoseconds and summed as ros::Time::toSec() sums them: the rig compared
+/// the command's time with its clock as that double, and a rerun that jumps to the next command must
+/// land on the same one to reproduce the run bit for bit (the nearest double to the decimal text can
+/// differ from it in the last bit).
+bool readStampSeconds(const std::string& text, double& seconds) {
+  const auto point = text.find('.');
+  const std::string whole = text.substr(0, point);
+  const std::string fraction = point == std::string::npos ? "" : text.substr(point + 1);
+  const auto digits = [](const std::string& part) {
+    return part.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (whole.empty() || whole.size() > 9 || fraction.size() > 9 || !digits(whole) || !digits(fraction)) {
+    return readNumber(text, seconds);
+  }
+  const double nanoseconds = fraction.empty() ? 0.0 : std::stod(fraction + std::string(9 - fraction.size(), '0'));
+  seconds = std::stod(whole) + 1e-9 * nanoseconds;
+  return true;
+}
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream stream(line);
+  std::string cell;
+  while (std::getline(stream, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+}  // namespace
+
+std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source) {
+  std::vector<TimedCommand> commands;
+  std::vector<std::string> problems;
+  std::istringstream text(csv_text);
+  std::string line;
+  int line_number = 0;
+  const std::string where_prefix = source.empty() ? "line " : source + ", line ";
+  auto problem = [&](const std::string& what) { problems.push_back(where_prefix + std::to_string(line_number) + ": " + what); };
+  bool header_seen = false;
+  while (std::getline(text, line)) {
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!header_seen) {
+      header_seen = true;
+      if (line != kCommandTableHeader) problem("the header must be '" + std::string(kCommandTableHeader) + "', got '" + line + "'");
+      continue;
+    }
+    if (line.empty()) continue;
+    const std::vector<std::string> cells = splitCsvLine(line);
+    if (cells.size() != 5) {
+      problem("5 fields expected (time_s, command, speed_m_s, target_m, normal_force_N), got " +
+              std::to_string(cells.size()) + " in '" + line + "'");
+      continue;
+    }
+    TimedCommand command;
+    if (!readStampSeconds(cells[0], command.time) || !std::isfinite(command.time) || command.time < 0.0) {
+      problem("time_s '" + cells[0] + "' is not allowed; allowed: a finite time >= 0 s");
+    } else if (!commands.empty() && command.time < commands.back().time) {
+      problem("time_s " + cells[0] + " is earlier than the row before; allowed: rows in time order");
+    }
+    // The fields each command takes, by column (speed, target, normal_force).
+    static const std::array<const char*, 3> kColumns{"speed_m_s", "target_m", "normal_force_N"};
+    std::array<bool, 3> takes{};
+    const std::string& name = cells[1];
+    if (name == "velocity") {
+      command.stage = {StageMode::Velocity, 0.0, 0.0};
+      takes = {true, false, false};
+    } else if (name == "hold") {
+      command.stage = {StageMode::Hold, 0.0, 0.0};
+    } else if (name == "position") {
+      command.stage = {StageMode::Position, 0.0, 0.0};
+      takes = {true, true, false};
+    } else if (name == "normal_load") {
+      command.kind = TimedCommand::Kind::NormalLoad;
+      takes = {false, false, true};
+    } else {
+      problem("command '" + name + "' is unknown; allowed: velocity, hold, position, normal_load");
+      continue;
+    }
+    std::array<double*, 3> fields{&command.stage.speed, &command.stage.target, &command.normal_force};
+    for (std::size_t column = 0; column < kColumns.size(); ++column) {
+      const std::string& cell = cells[column + 2];
+      if (!takes[column]) {
+        if (!cell.empty()) problem(name + " takes no " + kColumns[column] + ", got '" + cell + "'; leave it empty");
+      } else if (!readNumber(cell, *fields[column])) {
+        problem(name + " needs " + kColumns[column] + " as a number, got '" + cell + "'");
+      }
+    }
+    commands.push_back(command);
+  }
+  if (!header_seen) problems.push_back(where_prefix + "1: empty; a command table starts with its header '" +
+                                       std::string(kCommandTableHeader) + "'");
+  if (!problems.empty()) throw ConfigError("command table", problems);
+  return commands;
+}
+
+std::vector<TimedCommand> loadCommandTable(const std::string& path) {
+  std::vector<std::string> problems;
+  const std::string text = readTextFile(path, problems);
+  if (!problems.empty()) throw ConfigError("command table", problems);
+  return parseCommandTable(text, path);
 }
 
 bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time) {

@@ -494,6 +494,16 @@ std::string Simulation::setNormalLoad(double normal_force) {
   return {};
 }
 
+std::string Simulation::checkCommand(const TimedCommand& command) const {
+  return command.kind == TimedCommand::Kind::NormalLoad ? checkNormalLoad(command.normal_force)
+                                                        : stage_.checkCommand(command.stage);
+}
+
+std::string Simulation::apply(const TimedCommand& command) {
+  return command.kind == TimedCommand::Kind::NormalLoad ? setNormalLoad(command.normal_force)
+                                                        : stage_.command(command.stage);
+}
+
 LoadCellReading Simulation::loadCells() const {
   LoadCellReading reading;
   reading.time = time_;

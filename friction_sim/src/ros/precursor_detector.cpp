@@ -59,17 +59,26 @@ PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private
 }
 
 void PrecursorDetector::use(const DetectorSettings& settings) {
-  wave_speeds_ = settings.wave_speeds;
-  detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, wave_speeds_.longitudinal,
+  settings_ = settings;
+  detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, settings.wave_speeds.longitudinal,
                                                    settings.slider_length);
 }
 
 void PrecursorDetector::onScene(const std_msgs::String::ConstPtr& msg) {
-  // The same scene again is a looped bag starting its next pass, ahead of the last frames of this one:
-  // the time jumping back starts the analysis over once they are in (a new detector here lost the last
-  // event on every pass, found by a new-user walkthrough).
-  if (msg->data == scene_text_) return;
-  scene_text_ = msg->data;
+  DetectorSettings settings = detectorSettings(nullptr, front_fit_nodes_option_);
+  std::string name;  // empty while no scene is accepted
+  try {
+    const Scene scene = parseScene(msg->data);
+    settings = detectorSettings(&scene, front_fit_nodes_option_);
+    name = scene.name;
+  } catch (const ConfigError& error) {
+    ROS_WARN_STREAM("precursor detector: the run's scene is refused, so the wave speeds are unknown: " << error.what());
+  }
+  // A scene the detector measures the same with goes on with the analysis: the rig publishes its scene
+  // again with a new run end, and a looped bag starts its next pass with its first scene, ahead of the
+  // last frames of this pass (the time jumping back starts the analysis over once they are in; a new
+  // detector here lost the last event on every pass, found by a new-user walkthrough).
+  if (settings.sameAs(settings_)) return;
   // A new detector otherwise: what the old one saw was measured against another scene, or none. The
   // scene is its bag's first message, but it travels apart from the frames, which may come first.
   if (frames_seen_ > 0) {
@@ -77,14 +86,10 @@ void PrecursorDetector::onScene(const std_msgs::String::ConstPtr& msg) {
                                                                       << " interface frames; starting over without them");
   }
   frames_seen_ = 0;
-  try {
-    const Scene scene = parseScene(msg->data);
-    use(detectorSettings(&scene, front_fit_nodes_option_));
-    ROS_INFO_STREAM("precursor detector: using the run's scene " << scene.name << " (c_S = " << wave_speeds_.shear
-                                                                 << " m/s, L = " << scene.geometry.length << " m)");
-  } catch (const ConfigError& error) {
-    use(detectorSettings(nullptr, front_fit_nodes_option_));
-    ROS_WARN_STREAM("precursor detector: the run's scene is refused, so the wave speeds are unknown: " << error.what());
+  use(settings);
+  if (!name.empty()) {
+    ROS_INFO_STREAM("precursor detector: using the run's scene " << name << " (c_S = " << settings.wave_speeds.shear
+                                                                 << " m/s, L = " << settings.slider_length << " m)");
   }
 }
 
@@ -117,7 +122,7 @@ void PrecursorDetector::onFrame(const friction_msgs::InterfaceState::ConstPtr& m
 void PrecursorDetector::publishCompleted(bool no_more_readings) {
   for (const SlipEvent& event : detector_->takeCompletedEvents(no_more_readings)) {
     const double length = detector_->sliderLength();
-    events_pub_.publish(toMsg(event, positions_, length, wave_speeds_, frame_id_));
+    events_pub_.publish(toMsg(event, positions_, length, settings_.wave_speeds, frame_id_));
     points_pub_.publish(toPointMsg(event, length, frame_id_));
     ROS_INFO_STREAM("precursor detector: event " << event.index << " F_X/F_Z = "
                                                  << event.onset_shear_force / event.onset_normal_force

@@ -74,8 +74,7 @@ std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulatio
   if (msg.mode > friction_msgs::StageCommand::NORMAL_LOAD) {
     return "mode " + std::to_string(msg.mode) + " is unknown; allowed: 0 VELOCITY, 1 HOLD, 2 POSITION, 3 NORMAL_LOAD";
   }
-  if (msg.mode == friction_msgs::StageCommand::NORMAL_LOAD) return simulation.checkNormalLoad(msg.normal_force);
-  return simulation.stage().checkCommand(fromMsg(msg).stage);
+  return simulation.checkCommand(fromMsg(msg));
 }
 
 RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
@@ -146,22 +145,29 @@ void RigSimulator::advertise() {
   stop_srv_ = nh_.advertiseService("stop", &RigSimulator::onStop, this);
   abort_srv_ = nh_.advertiseService("abort", &RigSimulator::onAbort, this);
   run_end_srv_ = nh_.advertiseService("set_run_end", &RigSimulator::onSetRunEnd, this);
-  // What is run, overrides applied, for whoever joins later and in the bag: a recorded run can be
-  // analysed, or played back, with the scene it ran.
   scene_pub_ = nh_.advertise<std_msgs::String>("scene", 1, true);
+  publishScene();
+}
+
+void RigSimulator::publishScene() {
+  // What is run, overrides applied and with the run's end as it stands, for whoever joins later and in
+  // the bag: a recorded run can be analysed, played back or rerun offline with the scene it ran.
   std_msgs::String scene;
-  scene.data = sceneToYaml(scene_);
+  scene.data = sceneToYaml(simulation_->scene());
   scene_pub_.publish(scene);
   if (bag_open_) {
-    // Latched in the bag too, so that rosbag play latches it for whoever subscribes late; stamped at
-    // the bag's earliest time (a bag cannot hold a zero stamp).
+    // Latched in the bag too, so that rosbag play latches it for whoever subscribes late. The first is
+    // the bag's earliest message (1 ns: a bag cannot hold a zero stamp), a later one (a new run end) at
+    // its time, after the first.
     auto header = boost::make_shared<ros::M_string>();
     (*header)["type"] = ros::message_traits::datatype(scene);
     (*header)["md5sum"] = ros::message_traits::md5sum(scene);
     (*header)["message_definition"] = ros::message_traits::definition(scene);
     (*header)["callerid"] = ros::this_node::getName();
     (*header)["latching"] = "1";
-    bag_.write(scene_pub_.getTopic(), ros::Time(0, 1), scene, header);
+    const ros::Time earliest(0, scenes_recorded_ == 0 ? 1 : 2);
+    bag_.write(scene_pub_.getTopic(), std::max(toStamp(simulation_->time()), earliest), scene, header);
+    ++scenes_recorded_;
   }
 }
 
@@ -290,9 +296,7 @@ void RigSimulator::applyDueCommands() {
     if (command.time < now - simulation_->timeStep()) {
       ROS_DEBUG_STREAM("command for t = " << command.time << " s applied late, at " << now << " s");
     }
-    const std::string reason = command.kind == TimedCommand::Kind::NormalLoad
-                                   ? simulation_->setNormalLoad(command.normal_force)
-                                   : simulation_->stage().command(command.stage);
+    const std::string reason = simulation_->apply(command);
     if (reason.empty()) {
       friction_msgs::StageCommand applied = toMsg(command);
       applied.header.stamp = toStamp(now);
@@ -368,6 +372,7 @@ bool RigSimulator::onSetRunEnd(friction_msgs::SetRunEnd::Request& request, frict
   response.accepted = response.reason.empty();
   if (response.accepted) {
     run_end_set_ = true;
+    publishScene();
   } else {
     ROS_WARN_STREAM("run end refused: " << response.reason);
   }
@@ -393,6 +398,7 @@ void RigSimulator::run() {
     if (reset_requested_) {
       ++resets_;
       startSimulation();
+      publishScene();  // the scene's own run end again
       continue;
     }
     if (paused_) {

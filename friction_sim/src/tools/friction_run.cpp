@@ -12,10 +12,11 @@
 
 namespace {
 
-constexpr const char* kUsage = "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]...";
+constexpr const char* kUsage =
+    "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]... [--commands COMMANDS.csv]";
 
-/// Exit statuses: a command line that cannot be read, a scene refused (SceneError), and an output
-/// directory that cannot be written.
+/// Exit statuses: a command line that cannot be read, a scene or command table refused (ConfigError),
+/// and an output directory that cannot be written.
 constexpr int kBadCommandLine = 2;
 constexpr int kSceneRefused = 3;
 constexpr int kOutputUnwritable = 4;
@@ -39,10 +40,31 @@ int help() {
                "  stresses.csv     per event, at onset and end: strain gauges and interface stresses\n"
                "  scene.yaml       the scene as run;  summary.txt  the summary, also printed\n\n"
                "  --set key=value  overrides one scene field, e.g. --set pusher.height=0.01 (SI units);\n"
-               "                   validated like the file: a bad scene is refused with every problem listed.\n\n"
-               "Exit status: 0 when the run ends, 2 for a command line it cannot read, 3 for a refused scene,\n"
-               "4 when DIR cannot be written (checked before the run, and again for the files written after it).\n";
+               "                   validated like the file: a bad scene is refused with every problem listed.\n"
+               "  --commands FILE  drives the stage and F_Z by the commands of FILE, each applied at the first\n"
+               "                   step (or jump end) at or after its time, as the rig applies a controller's:\n"
+               "                   rig_report writes a recorded run's as stage_commands.csv, with its scene.yaml,\n"
+               "                   so that `friction_run scene.yaml --commands stage_commands.csv` reruns it.\n"
+               "                   Every command is checked against the scene before the run.\n\n"
+               "Exit status: 0 when the run ends, 2 for a command line it cannot read, 3 for a refused scene or\n"
+               "command table, 4 when DIR cannot be written (checked before the run, and again for the files\n"
+               "written after it).\n";
   return 0;
+}
+
+/// Refuses `commands` (read from `path`) with every problem listed, before anything runs, if the run's
+/// scene refuses any of them.
+void checkCommands(const std::vector<friction::TimedCommand>& commands, const std::string& path,
+                   const friction::Simulation& simulation) {
+  std::vector<std::string> problems;
+  for (std::size_t k = 0; k < commands.size(); ++k) {
+    const std::string reason = simulation.checkCommand(commands[k]);
+    if (!reason.empty()) {
+      problems.push_back(path + ", command " + std::to_string(k + 1) + " (t = " + std::to_string(commands[k].time) +
+                         " s): " + reason);
+    }
+  }
+  if (!problems.empty()) throw friction::ConfigError("command table", problems);
 }
 
 int run(int argc, char** argv) {
@@ -51,12 +73,14 @@ int run(int argc, char** argv) {
   }
   if (argc < 2) return refuseCommandLine("no scene file given");
   if (argv[1][0] == '-') return refuseCommandLine(std::string("the scene file comes first, got '") + argv[1] + "'");
-  std::string scene_path = argv[1], out_dir;
+  std::string scene_path = argv[1], out_dir, commands_path;
   std::vector<std::pair<std::string, std::string>> overrides;
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--out" && i + 1 < argc) {
       out_dir = argv[++i];
+    } else if (arg == "--commands" && i + 1 < argc) {
+      commands_path = argv[++i];
     } else if (arg == "--set" && i + 1 < argc) {
       const std::string assignment = argv[++i];
       const auto equals = assignment.find('=');
@@ -64,7 +88,7 @@ int run(int argc, char** argv) {
         return refuseCommandLine("--set needs key=value, got '" + assignment + "'");
       }
       overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
-    } else if (arg == "--out" || arg == "--set") {
+    } else if (arg == "--out" || arg == "--set" || arg == "--commands") {
       return refuseCommandLine(arg + " needs a value");
     } else {
       return refuseCommandLine("unknown argument '" + arg + "'");
@@ -73,15 +97,18 @@ int run(int argc, char** argv) {
   double stability_limit = 0.0;
   const friction::Scene scene = friction::loadScene(scene_path, overrides, &stability_limit);
   for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
+  const std::vector<friction::TimedCommand> commands =
+      commands_path.empty() ? std::vector<friction::TimedCommand>{} : friction::loadCommandTable(commands_path);
+  const auto start = std::chrono::steady_clock::now();
+  friction::Simulation simulation(scene, stability_limit);
+  checkCommands(commands, commands_path, simulation);
   if (out_dir.empty()) out_dir = "results/" + scene.name;
   std::error_code directory_error;
   std::filesystem::create_directories(out_dir, directory_error);
   if (directory_error) return refuseOutput(out_dir, "cannot create the directory (" + directory_error.message() + ")");
   std::ofstream stresses_csv(out_dir + "/stresses.csv");
   if (!stresses_csv) return refuseOutput(out_dir, "cannot create files in it");
-
-  const auto start = std::chrono::steady_clock::now();
-  friction::Simulation simulation(scene, stability_limit);
+  std::size_t next_command = 0, applied_commands = 0;
   std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
   stresses_csv << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
                   "interface_normal_stress_Pa,interface_shear_stress_Pa\n";
@@ -102,9 +129,20 @@ int run(int argc, char** argv) {
   double next_sample = sample_interval;
   friction::LoadCellReading before = loading.front();
   while (!simulation.finished()) {
-    // Several plain steps at once where they all end before the next loading-curve sample: the samples
-    // stay those of single steps.
-    simulation.advance(scene.stop.time, next_sample);
+    // The rig's rule: the commands due by now, then a step or a jump that ends where the next is due. A
+    // recorded time is its step's rounded to whole nanoseconds: due within half of one.
+    for (; next_command < commands.size() && commands[next_command].time <= simulation.time() + 0.5e-9; ++next_command) {
+      const std::string reason = simulation.apply(commands[next_command]);
+      if (reason.empty()) {
+        ++applied_commands;
+      } else {
+        std::cerr << "warning: command " << next_command + 1 << " refused: " << reason << "\n";
+      }
+    }
+    const double until = next_command < commands.size() ? commands[next_command].time : scene.stop.time;
+    // Several plain steps at once where they all end before the next loading-curve sample (and command):
+    // the samples stay those of single steps.
+    simulation.advance(until, std::min(next_sample, until));
     const friction::LoadCellReading after = simulation.loadCells();
     for (; next_sample <= after.time; next_sample += sample_interval) {
       loading.push_back(friction::interpolate(before, after, next_sample));
@@ -123,6 +161,10 @@ int run(int argc, char** argv) {
     before = after;
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!commands.empty()) {
+    std::cout << "commands: " << applied_commands << " of " << commands.size() << " applied (" << commands_path
+              << ")\n";
+  }
   if (scene.integrator.fast_forward) {
     std::cout << "fast-forward: " << simulation.jumps() << " jumps covering " << simulation.jumpedTime()
               << " s of " << simulation.time() << " s\n";
@@ -154,7 +196,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
   try {
     return run(argc, argv);
-  } catch (const friction::SceneError& error) {
+  } catch (const friction::ConfigError& error) {
     std::cerr << error.what() << "\n";
     return kSceneRefused;
   }

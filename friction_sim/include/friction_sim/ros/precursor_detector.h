@@ -56,6 +56,12 @@ struct DetectorSettings {
   WaveSpeeds wave_speeds;    ///< m/s, the model's (all 0, unknown, without a scene)
   int front_fit_nodes = 5;  ///< the options' or the scene's
   double slider_length = 0.0;  ///< m, L of L_p/L: the scene's geometry.length; 0 without a scene
+  /// Whether the detector measures the same with `other`.
+  bool sameAs(const DetectorSettings& other) const {
+    return wave_speeds.longitudinal == other.wave_speeds.longitudinal && wave_speeds.shear == other.wave_speeds.shear &&
+           wave_speeds.rayleigh == other.wave_speeds.rayleigh && front_fit_nodes == other.front_fit_nodes &&
+           slider_length == other.slider_length;
+  }
 };
 /// The settings from a run's `scene` (nullptr: none), with the ~front_fit_nodes option (0: the scene's).
 DetectorSettings detectorSettings(const Scene* scene, int front_fit_nodes);
@@ -78,11 +84,10 @@ class PrecursorDetector {
   ros::NodeHandle nh_, private_nh_;
   std::unique_ptr<FrameEventDetector> detector_;
   int front_fit_nodes_option_;  ///< ~front_fit_nodes, 0 = the scene's
-  WaveSpeeds wave_speeds_;
+  DetectorSettings settings_;  ///< in use
   std::vector<double> positions_;
   std::string frame_id_;  ///< the interface frames', for the events
   long frames_seen_ = 0;  ///< interface frames since the analysis last started over
-  std::string scene_text_;  ///< the scene in use, as received
   ros::Time last_stamp_;
   ros::Subscriber load_cells_sub_, interface_sub_, scene_sub_;
   ros::Publisher events_pub_, points_pub_;

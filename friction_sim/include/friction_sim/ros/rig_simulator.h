@@ -27,10 +27,13 @@
 //   lattice (friction_msgs/LatticeSnapshot)
 //   stage_state (friction_msgs/StageState)
 //   scene (std_msgs/String, latched)               the scene as run, overrides applied, in the scene YAML
-//                                                  format (also the bag's first message)
+//                                                  format (also the bag's first message); again with its
+//                                                  stop condition replaced when set_run_end is accepted,
+//                                                  and as it was after a reset
 //   applied_commands (friction_msgs/StageCommand)  every command as it took effect, stamped with the
 //                                                  simulated time of the step it took effect at: with the
-//                                                  scene, the bag's record of what drove the run
+//                                                  scene, the bag's record of what drove the run (rig_report
+//                                                  writes both out, and friction_run --commands reruns them)
 // Across a fast-forward jump each stream is interpolated on its own grid (the camera at
 // interface_idle_rate): the jump is cut only where a command is due, so that the run is the offline
 // runner's, step for step; paced (real_time_factor > 0) also at every interface frame, so that a watcher
@@ -123,6 +126,8 @@ class RigSimulator {
  private:
   void advertise();
   void startSimulation();
+  /// The scene as it runs now (its stop condition set_run_end's, if called) on `scene` and in the bag.
+  void publishScene();
   void publishInstruments();
   /// What the stage does at one instant.
   struct StageReading {
@@ -182,6 +187,7 @@ class RigSimulator {
   bool aborted_ = false;
   bool reset_requested_ = false;
   bool run_end_set_ = false;  ///< set_run_end was called: the run ends when the simulation finishes
+  int scenes_recorded_ = 0;    ///< scene messages written to the bag
   std::uint32_t resets_ = 0;  ///< resets so far, in stage_state: a controller cannot always tell one by the time
   std::uint32_t frame_index_ = 0;
   double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0,
