@@ -190,7 +190,7 @@ void RigPanel::onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
 
 void RigPanel::onEvent(const friction_msgs::SlipEvent::ConstPtr& msg) {
   events_.add(msg->onset_shear_force, msg->onset_normal_force, msg->rupture_length, msg->slider_length,
-              msg->global_event);
+              msg->global_event, msg->mean_slip < 0.0);
 }
 
 void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
@@ -219,6 +219,7 @@ void RigPanel::refresh() {
   const QColor blue(40, 90, 220);
   precursor_plot_->setSeries({events(EventKind::Precursor, blue, false, "precursor"),
                               events(EventKind::SingleNodeSlip, blue, true, "single-node slip (L_p = 0)"),
+                              events(EventKind::BackSlip, QColor(30, 150, 60), true, "back-slip (against x)"),
                               events(EventKind::AfterGlobal, QColor(150, 150, 150), false, "after a global slip"),
                               events(EventKind::Global, QColor(210, 30, 30), false, "global event")});
   const char* modes[] = {"velocity", "hold", "position"};

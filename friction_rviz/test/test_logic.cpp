@@ -70,18 +70,22 @@ TEST(History, SeriesKeepsAtMostItsCapacityAndClearsWhenTimeJumpsBack) {
   EXPECT_DOUBLE_EQ(history.values().front(), 1.0);
 }
 
-TEST(History, PrecursorPlotTellsSingleNodeSlipsPrecursorsGlobalEventsAndLaterCycles) {
+TEST(History, PrecursorPlotTellsSingleNodeSlipsPrecursorsBackSlipsGlobalEventsAndLaterCycles) {
   PrecursorScatter scatter;
-  scatter.add(192.0, 1920.0, 0.0, 0.14, false);    // one node alone
-  scatter.add(276.0, 1920.0, 0.035, 0.14, false);  // a precursor a quarter of the slider long
-  scatter.add(100.0, 0.0, 0.01, 0.14, false);      // no normal load: no F_X/F_Z to plot
-  scatter.add(399.0, 1920.0, 0.14, 0.14, true);
-  scatter.add(353.0, 1920.0, 0.0875, 0.14, false);  // arrested in the next stick–slip cycle
-  scatter.add(96.0, 1920.0, 0.0, 0.14, false);      // so is a single node after the global slip
+  scatter.add(192.0, 1920.0, 0.0, 0.14, false, false);    // one node alone
+  scatter.add(276.0, 1920.0, 0.035, 0.14, false, false);  // a precursor a quarter of the slider long
+  scatter.add(100.0, 0.0, 0.01, 0.14, false, false);      // no normal load: no F_X/F_Z to plot
+  scatter.add(68.0, 1920.0, 0.0275, 0.14, false, true);   // the stage drew back: the interface slid back
+  scatter.add(399.0, 1920.0, 0.14, 0.14, true, false);
+  scatter.add(353.0, 1920.0, 0.0875, 0.14, false, false);  // arrested in the next stick–slip cycle
+  scatter.add(96.0, 1920.0, 0.0, 0.14, false, false);      // so is a single node after the global slip
   const auto& single = scatter.points(EventKind::SingleNodeSlip);
   const auto& precursors = scatter.points(EventKind::Precursor);
   const auto& global = scatter.points(EventKind::Global);
   const auto& later = scatter.points(EventKind::AfterGlobal);
+  const auto& back = scatter.points(EventKind::BackSlip);
+  ASSERT_EQ(back.shear_ratio.size(), 1u);
+  EXPECT_DOUBLE_EQ(back.length_ratio[0], 0.0275 / 0.14);
   ASSERT_EQ(single.shear_ratio.size(), 1u);
   EXPECT_DOUBLE_EQ(single.shear_ratio[0], 0.1);
   EXPECT_DOUBLE_EQ(single.length_ratio[0], 0.0);
@@ -94,10 +98,10 @@ TEST(History, PrecursorPlotTellsSingleNodeSlipsPrecursorsGlobalEventsAndLaterCyc
   EXPECT_DOUBLE_EQ(later.shear_ratio[0], 353.0 / 1920.0);
   EXPECT_DOUBLE_EQ(later.length_ratio[0], 0.625);
   EXPECT_DOUBLE_EQ(later.length_ratio[1], 0.0);
-  EXPECT_EQ(eventKind(true, 0.0, false), EventKind::Global);  // a one-node interface's global event
+  EXPECT_EQ(eventKind(true, 0.0, false, false), EventKind::Global);  // a one-node interface's global event
   scatter.clear();  // time jumped back: the next event is before any global one again
   EXPECT_TRUE(scatter.points(EventKind::Global).shear_ratio.empty());
-  scatter.add(276.0, 1920.0, 0.035, 0.14, false);
+  scatter.add(276.0, 1920.0, 0.035, 0.14, false, false);
   EXPECT_EQ(scatter.points(EventKind::Precursor).shear_ratio.size(), 1u);
 }
 

@@ -546,6 +546,17 @@ TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
   EXPECT_NE(output.find("/friction_run " + arguments), std::string::npos) << output;
   ASSERT_EQ(runCommand("rosrun friction_sim friction_run " + arguments, output), 0) << output;
   EXPECT_EQ(readFile(out + "/rerun/events.csv"), offline_table.str());
+  // So does the offline runner given the launch's scene, overrides and protocol.
+  std::string scene_path, overrides, protocol_path;
+  ros::NodeHandle("~").getParam("scene", scene_path);
+  ros::NodeHandle("~").getParam("overrides", overrides);
+  ros::NodeHandle("~").getParam("protocol", protocol_path);
+  ASSERT_EQ(runCommand("rosrun friction_sim friction_run " + scene_path + " --set " + overrides + " --protocol " +
+                           protocol_path + " --out " + out + "/protocol_run",
+                       output),
+            0)
+      << output;
+  EXPECT_EQ(readFile(out + "/protocol_run/events.csv"), offline_table.str());
 }
 
 TEST(KillRun, BagIsReadableAndHoldsEverythingUpToTheKill) {

@@ -120,6 +120,16 @@ TEST(Conversions, CommandsRoundTripWithTheirTime) {
   EXPECT_DOUBLE_EQ(back.time, 0.5);
 }
 
+TEST(Conversions, AStampCarriesTheTimeTheCoreRoundsCommandsTo) {
+  // The offline runner applies a protocol's commands at stampSeconds(t), the time the rig reads from the
+  // controller's stamp: the same double, so that its run is the live one to the last digit. Among them
+  // a ramp's staircase, a time that rounds up into the next second and a time off the nanosecond grid.
+  for (const double t : {0.0, 0.00025 * 3, 0.001, 0.1300002, 0.4006564345821, 1.9999999996, 16.022026744912, 1e-10}) {
+    EXPECT_EQ(stampSeconds(t), ros::Time(t).toSec()) << t;
+    EXPECT_EQ(stampSeconds(t), fromMsg(toMsg(TimedCommand{t})).time) << t;
+  }
+}
+
 TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
   Scene scene;
   scene.model = ModelKind::Chain1D;

@@ -52,7 +52,7 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertIn("unknown argument '--sett'", message)
 
     def test_an_option_missing_its_value_is_named(self):
-        for option in ["--set", "--out", "--commands"]:
+        for option in ["--set", "--out", "--commands", "--protocol"]:
             status, message = self.refusal(SCENE, option)
             self.assertEqual(status, 2, option)
             self.assertIn("%s needs a value" % option, message)
@@ -108,6 +108,32 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertAlmostEqual(float(first["onset_time_s"]), 0.725, delta=2e-6)  # dt = 1 µs
         self.assertAlmostEqual(float(first["onset_normal_force_N"]), 2500.0, places=9)
         self.assertAlmostEqual(float(first["shear_ratio"]), 0.4, delta=1e-5)
+
+    def test_a_protocol_runs_as_the_controller_runs_it(self):
+        # F_Z ramped to 2500 N over 10 ms with the stage held, a hold to t0 = 0.1 s, then V = 0.4 mm/s:
+        # the block slips first at t = t0 + mu_s F_Z / (K V) = 0.1 + 0.4 * 2500 / (4e6 * 4e-4) = 0.725 s,
+        # and the protocol's end (one global event), not the scene's (three), ends the run.
+        protocol = os.path.join(self.work, "protocol.yaml")
+        with open(protocol, "w") as handle:
+            handle.write("steps:\n"
+                         "  - {action: normal_load, normal_force: 2500, ramp_time: 0.01}\n"
+                         "  - {action: hold, duration: 0.09}\n"
+                         "  - {action: drive, speed: 4.0e-4, duration: .inf}\n"
+                         "end: {global_events: 1}\n")
+        done = subprocess.run([self.runner, SCENE, "--out", self.out, "--protocol", protocol],
+                              capture_output=True, text=True, timeout=60)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertIn("commands: 23 of 23 applied", done.stdout)  # a hold, 20 ramp steps, a hold, a drive
+        self.assertIn("reached 1 global slip event", done.stdout)
+        with open(os.path.join(self.out, "events.csv")) as events:
+            rows = list(csv.DictReader(events))
+        self.assertEqual(len(rows), 1)
+        self.assertAlmostEqual(float(rows[0]["onset_time_s"]), 0.725, delta=2e-6)  # dt = 1 µs
+        self.assertAlmostEqual(float(rows[0]["shear_ratio"]), 0.4, delta=1e-5)
+        self.out = os.path.join(self.work, "refused")
+        status, message = self.refusal(SCENE, "--out", self.out, "--protocol", protocol, "--commands", protocol)
+        self.assertEqual(status, 2)
+        self.assertIn("--commands and --protocol both drive the stage; give one", message)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@
 namespace friction {
 namespace {
 
+using testing::coarseSliderScene;
 using testing::scenePath;
 
 class SideDrivenChain : public ::testing::Test {
@@ -431,6 +432,36 @@ TEST(StageProgram, HoldThenDriveThenMoveToATarget) {
   EXPECT_DOUBLE_EQ(stage.position(), 0.0);
   EXPECT_DOUBLE_EQ(stage.velocity(), 0.0);
   EXPECT_NEAR(stage.travel(), 2e-5, 1e-12);
+}
+
+TEST(StageProgram, WhileTheStageDrawsBackTheInterfaceSlipsBackAndNoPrecursorIsCounted) {
+  // Loaded for 30 ms at 4 mm/s (F_X/F_Z up to 0.17), drawn back to X_s = 0 over the next 30 ms, then
+  // loaded again to the first global event: the stored shear relaxes in events that slide against x.
+  Scene scene = coarseSliderScene(true);
+  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.03},
+                         StageSegment{StageMode::Position, 4e-3, 0.0, 0.03}, StageSegment{StageMode::Velocity, 4e-3}};
+  Simulation simulation(scene);
+  simulation.run();
+  const auto& events = simulation.events();
+  int back_slips = 0, precursors = 0;
+  for (const SlipEvent& event : events) {
+    if (event.global) break;
+    const bool drawing_back = event.onset_time > 0.03 && event.onset_time <= 0.06 + scene.integrator.time_step;
+    // Every node of an event slips the same way: the mean slip is at least a tenth of a micrometre.
+    EXPECT_GT(std::abs(event.meanSlip()), 1e-7) << "event " << event.index;
+    EXPECT_EQ(event.backSlip(), drawing_back) << "event " << event.index << " at t = " << event.onset_time;
+    ++(event.backSlip() ? back_slips : precursors);
+  }
+  EXPECT_GE(back_slips, 3);
+  EXPECT_GE(precursors, 6);  // both loadings' precursors
+  const RunSummary summary = summarize(simulation, 0.0);
+  EXPECT_EQ(summary.back_slips, back_slips);
+  EXPECT_EQ(summary.precursors, precursors);
+  EXPECT_EQ(summary.precursor_points.size(), static_cast<std::size_t>(precursors));
+  for (const PrecursorPoint& point : summary.precursor_points) EXPECT_GT(point.shear_ratio, 0.05);
+  std::ostringstream table;
+  writeEventsCsv(table, events, scene);
+  EXPECT_NE(table.str().find(",mean_slip_m\n"), std::string::npos);
 }
 
 TEST(StageProgram, AJumpEndingShortOfTheSegmentsEndDoesNotEndIt) {

@@ -63,6 +63,10 @@ LoadingProtocol loadProtocol(const std::string& path);
 std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, double start_time,
                                            double start_normal_force);
 
+/// s, `seconds` as a ROS stamp carries it, in whole nanoseconds (as ros::Time(seconds).toSec()): the time
+/// at which the rig applies a controller's command.
+double stampSeconds(double seconds);
+
 /// The commands of a command table, as rig_report writes a bag's applied commands (stage_commands.csv)
 /// for friction_run --commands:
 ///

@@ -45,6 +45,11 @@ struct SlipEvent {
   std::vector<double> front_speed;  ///< m/s, v_c per node from the first-unstick times; NaN where undefined
   double median_front_speed = std::numeric_limits<double>::quiet_NaN();  ///< m/s, summarizeFrontSpeeds; NaN: none
   int front_fits_left_out = 0;      ///< fits left out of that median (summarizeFrontSpeeds)
+  /// m, mean slip of the nodes that slipped (NaN if none did); negative for a back-slip.
+  double meanSlip() const;
+  /// The interface slid back, against x (meanSlip() < 0), as where the stage draws back and the shear
+  /// it stored relaxes: an event, but no precursor of sliding, whatever its extent.
+  bool backSlip() const { return meanSlip() < 0.0; }
 };
 
 /// The nodes that touched the track during an event so far: every one while none is lifted, which is

@@ -144,6 +144,18 @@ std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, doub
   return schedule;
 }
 
+double stampSeconds(double seconds) {
+  // ros::Time::fromSec, then toSec: the whole seconds, the rest rounded half away from zero to a
+  // nanosecond, carried into the seconds when it rounds up to one.
+  double whole = std::floor(seconds);
+  double nanoseconds = std::round((seconds - whole) * 1e9);
+  if (nanoseconds >= 1e9) {
+    whole += 1.0;
+    nanoseconds -= 1e9;
+  }
+  return whole + 1e-9 * nanoseconds;
+}
+
 namespace {
 
 constexpr const char* kCommandTableHeader = "time_s,command,speed_m_s,target_m,normal_force_N";

@@ -21,6 +21,10 @@ RunSummary summarize(const Simulation& simulation, double wall_time) {
       summary.kinetic_friction_macro = event.meanShearRatio();
       break;
     }
+    if (event.backSlip()) {
+      ++summary.back_slips;
+      continue;
+    }
     ++summary.precursors;
     if (event.rupture_length == 0.0) ++summary.single_node_precursors;
     summary.precursor_points.push_back(
@@ -43,6 +47,7 @@ void printSummary(std::ostream& out, const RunSummary& s) {
       << std::setprecision(4) << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
       << "  slip events: " << s.events << ", precursors before the first global event: " << s.precursors;
   if (s.single_node_precursors > 0) out << " (single-node slips, L_p = 0, among them: " << s.single_node_precursors << ")";
+  if (s.back_slips > 0) out << "; back-slips before it, not counted: " << s.back_slips;
   out << "\n";
   if (!s.precursor_points.empty()) {
     out << "  precursors (F_X/F_Z, L_p/L):";
@@ -61,7 +66,7 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
   out << "index,onset_time_s,end_time_s,onset_shear_force_N,onset_normal_force_N,shear_ratio,"
          "end_shear_force_N,nucleation_x_m,slip_min_x_m,slip_max_x_m,rupture_length_m,length_ratio,global,"
          "median_front_speed_m_s,front_speed_over_c_s,front_speed_over_c_r,front_fits_left_out,"
-         "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio,peak_shear_force_N,peak_shear_ratio\n";
+         "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio,peak_shear_force_N,peak_shear_ratio,mean_slip_m\n";
   out << std::setprecision(12);
   const double slider_length = scene.geometry.length;
   const WaveSpeeds speeds = waveSpeeds(scene);
@@ -74,7 +79,7 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
         << ',' << e.median_front_speed / speeds.shear << ','
         << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out
         << ',' << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio() << ','
-        << e.peak_shear_force << ',' << e.peakShearRatio() << '\n';
+        << e.peak_shear_force << ',' << e.peakShearRatio() << ',' << e.meanSlip() << '\n';
   }
 }
 

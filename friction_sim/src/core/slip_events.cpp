@@ -6,6 +6,17 @@
 
 namespace friction {
 
+double SlipEvent::meanSlip() const {
+  double sum = 0.0;
+  int slipped = 0;
+  for (std::size_t node = 0; node < node_slip.size() && node < first_unstick_time.size(); ++node) {
+    if (std::isnan(first_unstick_time[node])) continue;
+    sum += node_slip[node];
+    ++slipped;
+  }
+  return slipped > 0 ? sum / slipped : std::numeric_limits<double>::quiet_NaN();
+}
+
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }

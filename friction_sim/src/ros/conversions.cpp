@@ -92,6 +92,7 @@ friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>
   msg.rupture_length = event.rupture_length;
   msg.slider_length = slider_length;
   msg.global_event = event.global;
+  msg.mean_slip = event.meanSlip();
   msg.position = positions;
   msg.node_slip = event.node_slip;
   msg.first_unstick_time = event.first_unstick_time;
@@ -135,6 +136,7 @@ friction_msgs::PrecursorPoint toPointMsg(const SlipEvent& event, double slider_l
   msg.shear_ratio = event.onset_shear_force / event.onset_normal_force;
   msg.length_ratio = event.rupture_length / slider_length;
   msg.global_event = event.global;
+  msg.back_slip = event.backSlip();
   return msg;
 }
 

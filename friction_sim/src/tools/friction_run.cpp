@@ -13,9 +13,9 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]... [--commands COMMANDS.csv]";
+    "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]... [--commands COMMANDS.csv | --protocol PROTOCOL.yaml]";
 
-/// Exit statuses: a command line that cannot be read, a scene or command table refused (ConfigError),
+/// Exit statuses: a command line that cannot be read, a scene, command table or protocol refused (ConfigError),
 /// and an output directory that cannot be written.
 constexpr int kBadCommandLine = 2;
 constexpr int kSceneRefused = 3;
@@ -45,10 +45,13 @@ int help() {
                "                   step (or jump end) at or after its time, as the rig applies a controller's:\n"
                "                   rig_report writes a recorded run's as stage_commands.csv, with its scene.yaml,\n"
                "                   so that `friction_run scene.yaml --commands stage_commands.csv` reruns it.\n"
-               "                   Every command is checked against the scene before the run.\n\n"
-               "Exit status: 0 when the run ends, 2 for a command line it cannot read, 3 for a refused scene or\n"
-               "command table, 4 when DIR cannot be written (checked before the run, and again for the files\n"
-               "written after it).\n";
+               "                   Every command is checked against the scene before the run.\n"
+               "  --protocol FILE  runs a loading protocol (the stage controller's YAML) as the controller\n"
+               "                   does from t = 0: its commands at their times (in whole nanoseconds, as\n"
+               "                   they travel), and its end in place of the scene's stop condition.\n\n"
+               "Exit status: 0 when the run ends, 2 for a command line it cannot read, 3 for a refused scene,\n"
+               "command table or protocol, 4 when DIR cannot be written (checked before the run, and again for\n"
+               "the files written after it).\n";
   return 0;
 }
 
@@ -73,7 +76,7 @@ int run(int argc, char** argv) {
   }
   if (argc < 2) return refuseCommandLine("no scene file given");
   if (argv[1][0] == '-') return refuseCommandLine(std::string("the scene file comes first, got '") + argv[1] + "'");
-  std::string scene_path = argv[1], out_dir, commands_path;
+  std::string scene_path = argv[1], out_dir, commands_path, protocol_path;
   std::vector<std::pair<std::string, std::string>> overrides;
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -81,6 +84,8 @@ int run(int argc, char** argv) {
       out_dir = argv[++i];
     } else if (arg == "--commands" && i + 1 < argc) {
       commands_path = argv[++i];
+    } else if (arg == "--protocol" && i + 1 < argc) {
+      protocol_path = argv[++i];
     } else if (arg == "--set" && i + 1 < argc) {
       const std::string assignment = argv[++i];
       const auto equals = assignment.find('=');
@@ -88,20 +93,32 @@ int run(int argc, char** argv) {
         return refuseCommandLine("--set needs key=value, got '" + assignment + "'");
       }
       overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
-    } else if (arg == "--out" || arg == "--set" || arg == "--commands") {
+    } else if (arg == "--out" || arg == "--set" || arg == "--commands" || arg == "--protocol") {
       return refuseCommandLine(arg + " needs a value");
     } else {
       return refuseCommandLine("unknown argument '" + arg + "'");
     }
   }
+  if (!commands_path.empty() && !protocol_path.empty()) {
+    return refuseCommandLine("--commands and --protocol both drive the stage; give one");
+  }
   double stability_limit = 0.0;
-  const friction::Scene scene = friction::loadScene(scene_path, overrides, &stability_limit);
+  friction::Scene scene = friction::loadScene(scene_path, overrides, &stability_limit);
   for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
-  const std::vector<friction::TimedCommand> commands =
-      commands_path.empty() ? std::vector<friction::TimedCommand>{} : friction::loadCommandTable(commands_path);
+  std::vector<friction::TimedCommand> commands;
+  const std::string commands_source = commands_path.empty() ? protocol_path : commands_path;
+  if (!commands_path.empty()) commands = friction::loadCommandTable(commands_path);
+  if (!protocol_path.empty()) {
+    // As the stage controller runs it from t = 0: its schedule, each command at the time its stamp
+    // carries, and its end as the run's (set_run_end).
+    const friction::LoadingProtocol protocol = friction::loadProtocol(protocol_path);
+    commands = friction::scheduleProtocol(protocol, 0.0, scene.load.normal_force);
+    for (friction::TimedCommand& command : commands) command.time = friction::stampSeconds(command.time);
+    scene.stop = {protocol.end.global_events, protocol.end.time, protocol.end.stage_travel};
+  }
   const auto start = std::chrono::steady_clock::now();
   friction::Simulation simulation(scene, stability_limit);
-  checkCommands(commands, commands_path, simulation);
+  checkCommands(commands, commands_source, simulation);
   if (out_dir.empty()) out_dir = "results/" + scene.name;
   std::error_code directory_error;
   std::filesystem::create_directories(out_dir, directory_error);
@@ -162,7 +179,7 @@ int run(int argc, char** argv) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!commands.empty()) {
-    std::cout << "commands: " << applied_commands << " of " << commands.size() << " applied (" << commands_path
+    std::cout << "commands: " << applied_commands << " of " << commands.size() << " applied (" << commands_source
               << ")\n";
   }
   if (scene.integrator.fast_forward) {
