@@ -103,12 +103,14 @@ def run(path, jobs=None, hosts=None, out=None):
 
 
 def precursors(events):
-    """The events of one run's table before its first global slip event."""
+    """The events of one run's table before its first global slip event, back-slips (mean slip against x)
+    left out as friction_run's summary leaves them out."""
     out = []
     for event in events:
         if event["global"] == "1":
             break
-        out.append(event)
+        if not float(event.get("mean_slip_m", "0")) < 0.0:
+            out.append(event)
     return out
 
 
