@@ -257,7 +257,10 @@ Scene launchedScene() {
 std::vector<TimedCommand> launchedSchedule(const Scene& scene) {
   std::string protocol_path;
   ros::NodeHandle("~").getParam("protocol", protocol_path);
-  return scheduleProtocol(loadProtocol(protocol_path), 0.0, scene.load.normal_force);
+  std::vector<TimedCommand> schedule = scheduleProtocol(loadProtocol(protocol_path), 0.0, scene.load.normal_force);
+  // As the rig receives them: each at the time its stamp carries, which a sum of durations need not be.
+  for (TimedCommand& command : schedule) command.time = stampSeconds(command.time);
+  return schedule;
 }
 
 bool bagReadable(const std::string& path) {

@@ -89,8 +89,8 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         status, message = self.refusal(SCENE, "--out", self.out, "--commands", table)
         self.assertEqual(status, 3)
         self.assertIn("command table refused (2 problems)", message)
-        self.assertIn("command 1 (t = 0.000000 s): speed 2 m/s exceeds the stage's max_speed 1 m/s", message)
-        self.assertIn("command 2 (t = 0.100000 s): normal load 1e+09 N is not allowed", message)
+        self.assertIn("command 1 (t = 0 s): speed 2 m/s exceeds the stage's max_speed 1 m/s", message)
+        self.assertIn("command 2 (t = 0.1 s): normal load 1e+09 N is not allowed", message)
         status, message = self.refusal(SCENE, "--out", self.out, "--commands", os.path.join(self.work, "none.csv"))
         self.assertEqual(status, 3)
         self.assertIn("file '%s' cannot be read" % os.path.join(self.work, "none.csv"), message)
@@ -130,6 +130,22 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertEqual(len(rows), 1)
         self.assertAlmostEqual(float(rows[0]["onset_time_s"]), 0.725, delta=2e-6)  # dt = 1 µs
         self.assertAlmostEqual(float(rows[0]["shear_ratio"]), 0.4, delta=1e-5)
+        # With fast-forward the held block jumps from one F_Z command to the next, and the load cells
+        # sampled across each jump read the F_Z just set: 1920 + 29 k N after the k-th of the ramp's 20
+        # steps, at (k - 1) · 0.5 ms (they had ramped from the F_Z before it, a command late).
+        ramp = os.path.join(self.work, "ramp")
+        done = subprocess.run([self.runner, SCENE, "--out", ramp, "--protocol", protocol, "--set",
+                               "integrator.fast_forward=true"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(ramp, "loading.csv")) as loading:
+            samples = [row for row in csv.DictReader(loading) if float(row["time_s"]) < 0.0099]
+        checked = 0
+        for row in samples:
+            k, into = divmod(round(float(row["time_s"]) / 1e-4), 5)
+            if into > 0:  # not on a command's own time, where the step's end and the command coincide
+                self.assertAlmostEqual(float(row["normal_force_N"]), 1920.0 + 29.0 * (k + 1), places=6, msg=row)
+                checked += 1
+        self.assertEqual(checked, 79)
         self.out = os.path.join(self.work, "refused")
         status, message = self.refusal(SCENE, "--out", self.out, "--protocol", protocol, "--commands", protocol)
         self.assertEqual(status, 2)

@@ -121,7 +121,7 @@ class RigReportTest(unittest.TestCase):
         with open(os.path.join(self.work, "scene.yaml")) as scene:
             self.assertEqual(scene.read(), with_end)
         self.assertFalse(os.path.exists(os.path.join(self.work, "stage_commands.csv")))
-        self.assertIn("the bag has no applied_commands topic: no stage_commands.csv", done.stdout)
+        self.assertIn("the bag holds no applied commands: no stage_commands.csv", done.stdout)
         self.assertIn("friction_run {0}/scene.yaml --out {0}/rerun".format(self.work), done.stdout)
 
     def test_the_detectors_events_on_request(self):

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 
 #include "friction_sim/results_io.h"
@@ -410,6 +411,9 @@ TEST(Determinism, AStopConditionSetDuringTheRunEndsItOnTheSameStepAsTheScenes) {
   EXPECT_NE(past.find("allowed: > " + streamed(changed.stage().travel()) + " m, the travel now"),
             std::string::npos)
       << past;
+  // No condition at all: the run would never end, and the scene the rig records with it would be refused.
+  const double endless = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(changed.setStopCondition(StopSpec{0, endless, endless}), std::string(kNoEndProblem));
   bad = later;
   EXPECT_EQ(changed.setStopCondition(bad),
             "global_events 2 is already reached (2 so far); allowed: > 2 (0: not this condition)");

@@ -56,6 +56,14 @@ TEST(SceneFiles, WrittenSceneReadsBackIdentically) {
   EXPECT_EQ(read_back.stop.global_events, 4);
   EXPECT_TRUE(std::isinf(read_back.stop.time));
   EXPECT_TRUE(std::isinf(read_back.stop.stage_travel));
+  // Every number to its last bit: an override with more digits than the ten written before, and a time
+  // that is a sum of durations.
+  scene.pusher.height = 0.0123456789012345;
+  scene.stop.time = 0.001 + 0.019 + 0.1;
+  const Scene exact = parseScene(sceneToYaml(scene));
+  EXPECT_EQ(exact.pusher.height, scene.pusher.height);
+  EXPECT_EQ(exact.stop.time, scene.stop.time);
+  EXPECT_EQ(exact.material.youngs_modulus, 3.0e9);
 }
 
 TEST(SceneFiles, OverridesAreParsedAndValidatedLikeTheFile) {

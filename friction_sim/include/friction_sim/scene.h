@@ -118,6 +118,15 @@ struct StopSpec {
   double stage_travel = std::numeric_limits<double>::infinity();  ///< m, stop after this stage travel
 };
 
+/// Whether `stop` has a condition that ends a run: a count of global events, or a finite time or travel.
+inline bool endsTheRun(const StopSpec& stop) {
+  return stop.global_events > 0 || stop.time < std::numeric_limits<double>::infinity() ||
+         stop.stage_travel < std::numeric_limits<double>::infinity();
+}
+/// The refusal of a stop condition that does not (scenes and set_run_end alike).
+constexpr const char* kNoEndProblem =
+    "no condition, so the run would never end; give global_events, time or stage_travel";
+
 struct Scene {
   std::string name = "pmma_2d";  ///< names the run's results (results/<name>) and its summary
   ModelKind model = ModelKind::Lattice2D;  ///< 2D lattice in the x–z plane, or 1D chain of blocks

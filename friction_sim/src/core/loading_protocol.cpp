@@ -224,7 +224,10 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
       continue;
     }
     TimedCommand command;
-    if (!readStampSeconds(cells[0], command.time) || !std::isfinite(command.time) || command.time < 0.0) {
+    // A row whose time is refused is left out, so that the next is compared with the last good one.
+    const bool time_readable =
+        readStampSeconds(cells[0], command.time) && std::isfinite(command.time) && command.time >= 0.0;
+    if (!time_readable) {
       problem("time_s '" + cells[0] + "' is not allowed; allowed: a finite time >= 0 s");
     } else if (!commands.empty() && command.time < commands.back().time) {
       problem("time_s " + cells[0] + " is earlier than the row before; allowed: rows in time order");
@@ -257,7 +260,7 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
         problem(name + " needs " + kColumns[column] + " as a number, got '" + cell + "'");
       }
     }
-    commands.push_back(command);
+    if (time_readable) commands.push_back(command);
   }
   if (!header_seen) problems.push_back(where_prefix + "1: empty; a command table starts with its header '" +
                                        std::string(kCommandTableHeader) + "'");

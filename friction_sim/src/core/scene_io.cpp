@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -44,11 +45,12 @@ const EnumTable<StageMode>& enumTable(StageMode) { return kStageModeNames; }
 
 namespace {
 
+/// The shortest text that reads back as `value`, to the last bit: a scene written out (the rig records
+/// its scene so, and a rerun reads it) is the scene that ran.
 std::string formatNumber(double value) {
-  std::ostringstream text;
-  text.precision(10);
-  text << value;
-  return text.str();
+  char text[32];
+  const auto written = std::to_chars(text, text + sizeof text, value);
+  return std::string(text, written.ptr);
 }
 
 // The one description of the scene's YAML layout, walked by both the reader and the writer so that

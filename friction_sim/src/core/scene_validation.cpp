@@ -165,9 +165,7 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
   // ∞ allowed, as set_run_end allows it: the rig publishes and records its scene with the run's end.
   check.require(s.stop.time > 0.0, "stop.time", s.stop.time, "a time > 0 s (.inf allowed)");
   check.require(s.stop.stage_travel > 0.0, "stop.stage_travel", s.stop.stage_travel, "a travel > 0 m (.inf allowed)");
-  if (s.stop.global_events == 0 && std::isinf(s.stop.time) && std::isinf(s.stop.stage_travel)) {
-    check.problems.push_back("stop: no condition, so the run would never end; give global_events, time or stage_travel");
-  }
+  if (!endsTheRun(s.stop)) check.problems.push_back(std::string("stop: ") + kNoEndProblem);
   check.positive("integrator.time_step", s.integrator.time_step);
   if (s.integrator.fast_forward) {
     check.require(s.friction.interfacial_stiffness == 0.0, "friction.interfacial_stiffness",

@@ -206,7 +206,9 @@ bool Simulation::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   const double stage_end = stage_.positionAfter(jump);
   u_ += (stage_end - stage_start) * along;
   stage_.advance(jump);
-  time_ += jump;
+  // A jump to the caller's time ends on it exactly: time_ + (until − time_) can fall an ulp short, and a
+  // command due then would wait a step (the rig compares due times with the clock exactly).
+  time_ = !stops_at_threshold && jump == horizon ? std::min(until, scene_.stop.time) : time_ + jump;
   const double kinetic_before = kineticEnergy();
   solver->solve(*model_, u_, stage_end);
   v_.swap(path_velocity);
@@ -461,6 +463,7 @@ std::string Simulation::setStopCondition(const StopSpec& stop) {
     problem() << "stage_travel " << stop.stage_travel << " m is not allowed; allowed: > "
               << stage_.travel() << " m, the travel now (inf: not this condition)";
   }
+  if (!endsTheRun(stop)) problem() << kNoEndProblem;
   if (!reason.str().empty()) return reason.str();
   scene_.stop = stop;
   stop_reason_.clear();

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "friction_sim/results_io.h"
 #include "friction_sim/scene_io.h"
@@ -42,7 +43,8 @@ int help() {
                "  --set key=value  overrides one scene field, e.g. --set pusher.height=0.01 (SI units);\n"
                "                   validated like the file: a bad scene is refused with every problem listed.\n"
                "  --commands FILE  drives the stage and F_Z by the commands of FILE, each applied at the first\n"
-               "                   step (or jump end) at or after its time, as the rig applies a controller's:\n"
+               "                   step (or jump end) at or after its time (within the half nanosecond its\n"
+               "                   recorded time was rounded by), as the rig applies a controller's:\n"
                "                   rig_report writes a recorded run's as stage_commands.csv, with its scene.yaml,\n"
                "                   so that `friction_run scene.yaml --commands stage_commands.csv` reruns it.\n"
                "                   Every command is checked against the scene before the run.\n"
@@ -63,8 +65,10 @@ void checkCommands(const std::vector<friction::TimedCommand>& commands, const st
   for (std::size_t k = 0; k < commands.size(); ++k) {
     const std::string reason = simulation.checkCommand(commands[k]);
     if (!reason.empty()) {
-      problems.push_back(path + ", command " + std::to_string(k + 1) + " (t = " + std::to_string(commands[k].time) +
-                         " s): " + reason);
+      std::ostringstream where;
+      where.precision(12);
+      where << path << ", command " << k + 1 << " (t = " << commands[k].time << " s): ";
+      problems.push_back(where.str() + reason);
     }
   }
   if (!problems.empty()) throw friction::ConfigError("command table", problems);
@@ -152,6 +156,9 @@ int run(int argc, char** argv) {
       const std::string reason = simulation.apply(commands[next_command]);
       if (reason.empty()) {
         ++applied_commands;
+        // The load cells from the command on (F_Z steps, the slider relaxes): samples across the next
+        // step or jump are drawn from here, as the rig draws them.
+        before = simulation.loadCells();
       } else {
         std::cerr << "warning: command " << next_command + 1 << " refused: " << reason << "\n";
       }

@@ -17,7 +17,9 @@
 //   overrides (string, "")     the run's scene overrides, "key=value key=value", as the simulator's
 // Subscribed topics (relative to the node's namespace):
 //   load_cells (geometry_msgs/WrenchStamped), interface (friction_msgs/InterfaceState)
-//   scene (std_msgs/String)    without ~scene only: the run's scene; its arrival starts the analysis over
+//   scene (std_msgs/String)    without ~scene only: the run's scene; one the detector measures differently
+//                              with (wave speeds, fit window, L) starts the analysis over, the same scene
+//                              again (a new run end, a looped bag's next pass) does not
 // Published topics (private), in the interface frames' frame_id:
 //   ~slip_events (friction_msgs/SlipEvent), ~precursor_points (friction_msgs/PrecursorPoint)
 //

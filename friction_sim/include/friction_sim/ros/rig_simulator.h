@@ -37,8 +37,8 @@
 // Across a fast-forward jump each stream is interpolated on its own grid (the camera at
 // interface_idle_rate): the jump is cut only where a command is due, so that the run is the offline
 // runner's, step for step; paced (real_time_factor > 0) also at every interface frame, so that a watcher
-// sees the slider move and a command sent "now" acts within a frame; and while the stage is at rest,
-// whose jumps move nothing and, with nothing due, would have no end.
+// sees the slider move and a command sent "now" acts within a frame; and while the stage rests with no
+// end in sight (nothing due, no program segment to end), whose jumps would have no end.
 // Subscribed topics:
 //   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time)
 // Services:
