@@ -93,7 +93,8 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertIn("command 2 (t = 0.1 s): normal load 1e+09 N is not allowed", message)
         status, message = self.refusal(SCENE, "--out", self.out, "--commands", os.path.join(self.work, "none.csv"))
         self.assertEqual(status, 3)
-        self.assertIn("file '%s' cannot be read" % os.path.join(self.work, "none.csv"), message)
+        self.assertIn("file '%s' cannot be read (No such file or directory)" % os.path.join(self.work, "none.csv"),
+                      message)
 
     def test_commands_drive_the_stage_and_the_normal_load(self):
         # The single block held while F_Z goes from 1920 to 2500 N, then driven at V = 0.4 mm/s from

@@ -5,8 +5,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <set>
@@ -219,7 +221,7 @@ YAML::Node loadMapping(const std::string& text, const std::string& what, const s
 std::string readTextFile(const std::string& path, std::vector<std::string>& problems) {
   std::ifstream file(path);
   if (!file) {
-    problems.push_back("file '" + path + "' cannot be read");
+    problems.push_back("file '" + path + "' cannot be read (" + std::strerror(errno) + ")");
     return {};
   }
   std::stringstream text;

@@ -111,7 +111,12 @@ int run(int argc, char** argv) {
   for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
   std::vector<friction::TimedCommand> commands;
   const std::string commands_source = commands_path.empty() ? protocol_path : commands_path;
-  if (!commands_path.empty()) commands = friction::loadCommandTable(commands_path);
+  if (!commands_path.empty()) {
+    commands = friction::loadCommandTable(commands_path);
+    if (commands.empty()) {
+      std::cerr << "warning: " << commands_path << " holds no commands: the scene's stage program drives the run\n";
+    }
+  }
   if (!protocol_path.empty()) {
     // As the stage controller runs it from t = 0: its schedule, each command at the time its stamp
     // carries, and its end as the run's (set_run_end).
@@ -185,7 +190,7 @@ int run(int argc, char** argv) {
     before = after;
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!commands.empty()) {
+  if (!commands_source.empty()) {
     std::cout << "commands: " << applied_commands << " of " << commands.size() << " applied (" << commands_source
               << ")\n";
   }
