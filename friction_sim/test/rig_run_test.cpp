@@ -34,6 +34,7 @@
 #include <memory>
 #include <sstream>
 
+#include "friction_sim/command_schedule.h"
 #include "friction_sim/loading_protocol.h"
 #include "friction_sim/results_io.h"
 #include "friction_sim/ros/conversions.h"
@@ -517,13 +518,11 @@ TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
   // jump cut only where the next command is due (the instruments are interpolated across it).
   Simulation offline(launchedScene());
   ASSERT_TRUE(offline.scene().integrator.fast_forward);
-  const auto schedule = launchedSchedule(offline.scene());
-  std::size_t next = 0;
+  CommandSchedule schedule;
+  for (const TimedCommand& command : launchedSchedule(offline.scene())) schedule.add(command);
   while (offline.globalEventCount() < 2 && offline.time() < 5.0) {
-    for (; next < schedule.size() && schedule[next].time <= offline.time(); ++next) {
-      offline.stage().command(schedule[next].stage);
-    }
-    offline.advance(next < schedule.size() ? schedule[next].time : std::numeric_limits<double>::infinity());
+    schedule.applyDue(offline, [](const TimedCommand&, const std::string& refusal) { EXPECT_EQ(refusal, ""); });
+    offline.advance(schedule.nextTime());
   }
   EXPECT_GT(offline.jumps(), 0);
   // The simulator ends the run itself on the step of the protocol's end (set_run_end), however late the

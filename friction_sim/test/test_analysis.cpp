@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "friction_sim/command_schedule.h"
 #include "friction_sim/frame_event_detector.h"
 #include "friction_sim/loading_protocol.h"
 #include "friction_sim/results_io.h"
@@ -177,6 +178,47 @@ TEST(CommandTable, ARunRefusesWhatItsSceneRefusesAndAppliesTheRest) {
   EXPECT_EQ(simulation.apply(commands[3]), "");
   EXPECT_EQ(simulation.stage().current().mode, StageMode::Position);
   EXPECT_EQ(simulation.stage().current().target, 2e-4);
+}
+
+TEST(CommandSchedule, AppliesWhatIsDueInTimeOrderAndNamesWhereToCutTheNextJump) {
+  Scene scene;
+  scene.model = ModelKind::Chain1D;
+  scene.chain.blocks = 1;
+  scene.integrator.time_step = 1e-6;
+  Simulation simulation(scene);
+  auto stage = [](double time, StageMode mode, double speed) {
+    TimedCommand command;
+    command.time = time;
+    command.stage = {mode, speed, 0.0};
+    return command;
+  };
+  TimedCommand load;
+  load.kind = TimedCommand::Kind::NormalLoad;
+  load.normal_force = 2500.0;
+  CommandSchedule schedule;
+  EXPECT_TRUE(std::isinf(schedule.nextTime()));
+  schedule.add(stage(1e-3, StageMode::Velocity, 4e-4));
+  schedule.add(stage(0.0, StageMode::Velocity, 2.0));  // beyond max_speed: refused, and reported
+  schedule.add(load);                                  // t = 0, after the one before
+  std::vector<std::string> reports;
+  auto report = [&](const TimedCommand& command, const std::string& refusal) {
+    reports.push_back(std::to_string(command.time) + (refusal.empty() ? " applied" : " refused"));
+  };
+  EXPECT_EQ(schedule.nextTime(), 0.0);
+  EXPECT_EQ(schedule.applyDue(simulation, report), 1);
+  EXPECT_EQ(reports, (std::vector<std::string>{"0.000000 refused", "0.000000 applied"}));
+  EXPECT_EQ(simulation.loadCells().normal_force, 2500.0);
+  EXPECT_EQ(schedule.nextTime(), 1e-3);
+  EXPECT_EQ(schedule.applyDue(simulation, report), 0);  // not due before its time
+  for (int step = 0; step < 5; ++step) simulation.advance(schedule.nextTime());
+  // A time recorded a third of a nanosecond after the step's (rounded to whole nanoseconds) is due on
+  // that step with half a nanosecond's grace, not without.
+  CommandSchedule exact, recorded(0.5e-9);
+  exact.add(stage(simulation.time() + 0.3e-9, StageMode::Hold, 0.0));
+  recorded.add(stage(simulation.time() + 0.3e-9, StageMode::Hold, 0.0));
+  EXPECT_EQ(exact.applyDue(simulation, report), 0);
+  EXPECT_EQ(recorded.applyDue(simulation, report), 1);
+  EXPECT_EQ(simulation.stage().current().mode, StageMode::Hold);
 }
 
 TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {

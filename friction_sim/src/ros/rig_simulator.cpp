@@ -284,32 +284,28 @@ std::string RigSimulator::accept(const friction_msgs::StageCommand& msg) {
     ROS_WARN_STREAM("stage command refused: " << reason);
     return reason;
   }
-  const TimedCommand command = fromMsg(msg);
-  pending_.emplace(command.time, command);
+  pending_.add(fromMsg(msg));
   return {};
 }
 
 void RigSimulator::applyDueCommands() {
   const double now = simulation_->time();
-  while (!pending_.empty() && pending_.begin()->first <= now) {
-    const TimedCommand& command = pending_.begin()->second;
+  pending_.applyDue(*simulation_, [&](const TimedCommand& command, const std::string& refusal) {
+    if (!refusal.empty()) {
+      ROS_WARN_STREAM("stage command refused: " << refusal);
+      return;
+    }
     if (command.time < now - simulation_->timeStep()) {
       ROS_DEBUG_STREAM("command for t = " << command.time << " s applied late, at " << now << " s");
     }
-    const std::string reason = simulation_->apply(command);
-    if (reason.empty()) {
-      friction_msgs::StageCommand applied = toMsg(command);
-      applied.header.stamp = toStamp(now);
-      applied.header.frame_id = options_.frame_id;
-      applied_commands_pub_.publish(applied);
-      // Unlike a measurement, a command at t = 0 matters: in the bag at its earliest time after the
-      // scene's (1 ns), its stamp kept.
-      if (bag_open_) bag_.write(applied_commands_pub_.getTopic(), std::max(applied.header.stamp, ros::Time(0, 2)), applied);
-    } else {
-      ROS_WARN_STREAM("stage command refused: " << reason);
-    }
-    pending_.erase(pending_.begin());
-  }
+    friction_msgs::StageCommand applied = toMsg(command);
+    applied.header.stamp = toStamp(now);
+    applied.header.frame_id = options_.frame_id;
+    applied_commands_pub_.publish(applied);
+    // Unlike a measurement, a command at t = 0 matters: in the bag at its earliest time after the
+    // scene's (1 ns), its stamp kept.
+    if (bag_open_) bag_.write(applied_commands_pub_.getTopic(), std::max(applied.header.stamp, ros::Time(0, 2)), applied);
+  });
 }
 
 void RigSimulator::onCommand(const friction_msgs::StageCommand::ConstPtr& msg) { accept(*msg); }
@@ -420,7 +416,7 @@ void RigSimulator::run() {
     // solves the equilibrium afresh, so cutting one changes the run in its last digits (a hold of a
     // stop-and-go protocol, cut at 100 Hz, had made the events after it differ from the offline
     // runner's by 1e-12 to 1e-9; found by a new-user walkthrough).
-    double until = pending_.empty() ? std::numeric_limits<double>::infinity() : pending_.begin()->first;
+    double until = pending_.nextTime();
     // A frame within a step of the command is no cut: the jump would stop a hair short of it, and the
     // step after would pass it (the command applied a step late, found by a new-user walkthrough).
     const Stage& stage = simulation_->stage();

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "friction_sim/command_schedule.h"
 #include "friction_sim/results_io.h"
 #include "friction_sim/scene_io.h"
 #include "friction_sim/simulation.h"
@@ -134,7 +135,11 @@ int run(int argc, char** argv) {
   if (directory_error) return refuseOutput(out_dir, "cannot create the directory (" + directory_error.message() + ")");
   std::ofstream stresses_csv(out_dir + "/stresses.csv");
   if (!stresses_csv) return refuseOutput(out_dir, "cannot create files in it");
-  std::size_t next_command = 0, applied_commands = 0;
+  // A recorded time is its step's rounded to whole nanoseconds: due within half of one. A protocol's
+  // times are the ones the rig compared its clock with: due exactly then.
+  friction::CommandSchedule schedule(commands_path.empty() ? 0.0 : 0.5e-9);
+  for (const friction::TimedCommand& command : commands) schedule.add(command);
+  int applied_commands = 0;
   std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
   stresses_csv << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
                   "interface_normal_stress_Pa,interface_shear_stress_Pa\n";
@@ -155,20 +160,19 @@ int run(int argc, char** argv) {
   double next_sample = sample_interval;
   friction::LoadCellReading before = loading.front();
   while (!simulation.finished()) {
-    // The rig's rule: the commands due by now, then a step or a jump that ends where the next is due. A
-    // recorded time is its step's rounded to whole nanoseconds: due within half of one.
-    for (; next_command < commands.size() && commands[next_command].time <= simulation.time() + 0.5e-9; ++next_command) {
-      const std::string reason = simulation.apply(commands[next_command]);
-      if (reason.empty()) {
+    // The rig's rule (CommandSchedule): the commands due by now, then a step or a jump that ends where
+    // the next is due.
+    schedule.applyDue(simulation, [&](const friction::TimedCommand& command, const std::string& refusal) {
+      if (refusal.empty()) {
         ++applied_commands;
         // The load cells from the command on (F_Z steps, the slider relaxes): samples across the next
         // step or jump are drawn from here, as the rig draws them.
         before = simulation.loadCells();
       } else {
-        std::cerr << "warning: command " << next_command + 1 << " refused: " << reason << "\n";
+        std::cerr << "warning: command at t = " << command.time << " s refused: " << refusal << "\n";
       }
-    }
-    const double until = next_command < commands.size() ? commands[next_command].time : scene.stop.time;
+    });
+    const double until = schedule.nextTime();
     // Several plain steps at once where they all end before the next loading-curve sample (and command):
     // the samples stay those of single steps.
     simulation.advance(until, std::min(next_sample, until));

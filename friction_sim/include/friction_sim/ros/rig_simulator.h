@@ -74,11 +74,11 @@
 
 #include <atomic>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "friction_sim/command_schedule.h"
 #include "friction_sim/loading_protocol.h"
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/simulation.h"
@@ -179,7 +179,7 @@ class RigSimulator {
   std::unique_ptr<Simulation> simulation_;
   std::vector<double> interface_positions_;
   WaveSpeeds wave_speeds_;
-  std::multimap<double, TimedCommand> pending_;  ///< accepted commands by simulated time
+  CommandSchedule pending_;  ///< accepted commands, due at their simulated times
   rosbag::Bag bag_;
   bool bag_open_ = false;
   bool paused_ = false;
