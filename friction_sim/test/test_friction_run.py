@@ -79,18 +79,15 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         return path
 
     def test_a_bad_command_table_lists_every_problem_before_the_run(self):
-        table = self.commands(["0,hold,,,", "0.1,velocity,fast,,"])
+        # The table's own problems and what the scene refuses (a speed beyond its stage.max_speed, 1 m/s;
+        # F_Z beyond 5 % of E over the base), all at once, each with its line.
+        table = self.commands(["0,hold,,,", "0.1,velocity,fast,,", "0.2,velocity,2.0,,", "0.3,normal_load,,,1e9"])
         status, message = self.refusal(SCENE, "--out", self.out, "--commands", table)
         self.assertEqual(status, 3)
-        self.assertIn("command table refused (1 problem)", message)
+        self.assertIn("command table refused (3 problems)", message)
         self.assertIn("%s, line 3: velocity needs speed_m_s as a number, got 'fast'" % table, message)
-        # What the scene refuses: a speed beyond its stage.max_speed (1 m/s), F_Z beyond 5 % of E over the base.
-        table = self.commands(["0,velocity,2.0,,", "0.1,normal_load,,,1e9"])
-        status, message = self.refusal(SCENE, "--out", self.out, "--commands", table)
-        self.assertEqual(status, 3)
-        self.assertIn("command table refused (2 problems)", message)
-        self.assertIn("command 1 (t = 0 s): speed 2 m/s exceeds the stage's max_speed 1 m/s", message)
-        self.assertIn("command 2 (t = 0.1 s): normal load 1e+09 N is not allowed", message)
+        self.assertIn("%s, line 4: speed 2 m/s exceeds the stage's max_speed 1 m/s" % table, message)
+        self.assertIn("%s, line 5: normal load 1e+09 N is not allowed" % table, message)
         status, message = self.refusal(SCENE, "--out", self.out, "--commands", os.path.join(self.work, "none.csv"))
         self.assertEqual(status, 3)
         self.assertIn("file '%s' cannot be read (No such file or directory)" % os.path.join(self.work, "none.csv"),

@@ -10,6 +10,7 @@
 //   end: {global_events: 4, stage_travel: .inf, time: .inf}           # count, m, s
 #pragma once
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -78,9 +79,12 @@ double stampSeconds(double seconds);
 ///
 /// One row per command, in time order (s, simulated); `command` is velocity (speed), hold, position
 /// (speed, target) or normal_load (normal_force), and the fields its mode does not use stay empty.
-/// Throws ConfigError listing every problem with its line.
-std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source = "");
-std::vector<TimedCommand> loadCommandTable(const std::string& path);
+/// `check`, if given, says why a well-formed command would be refused (empty if not), as the run's
+/// simulation does. Throws ConfigError listing every problem with its line.
+using CommandCheck = std::function<std::string(const TimedCommand&)>;
+std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source = "",
+                                            const CommandCheck& check = nullptr);
+std::vector<TimedCommand> loadCommandTable(const std::string& path, const CommandCheck& check = nullptr);
 
 /// True once an end condition of the protocol holds.
 bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time);

@@ -199,7 +199,8 @@ std::vector<std::string> splitCsvLine(const std::string& line) {
 
 }  // namespace
 
-std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source) {
+std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source,
+                                            const CommandCheck& check) {
   std::vector<TimedCommand> commands;
   std::vector<std::string> problems;
   std::istringstream text(csv_text);
@@ -224,6 +225,7 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
       continue;
     }
     TimedCommand command;
+    const std::size_t problems_before_row = problems.size();
     // A row whose time is refused is left out, so that the next is compared with the last good one.
     const bool time_readable =
         readStampSeconds(cells[0], command.time) && std::isfinite(command.time) && command.time >= 0.0;
@@ -260,6 +262,11 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
         problem(name + " needs " + kColumns[column] + " as a number, got '" + cell + "'");
       }
     }
+    // What the run would refuse, for a row that is well formed: listed with the table's own problems.
+    if (check && problems.size() == problems_before_row) {
+      const std::string refusal = check(command);
+      if (!refusal.empty()) problem(refusal);
+    }
     if (time_readable) commands.push_back(command);
   }
   if (!header_seen) problems.push_back(where_prefix + "1: empty; a command table starts with its header '" +
@@ -268,11 +275,11 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
   return commands;
 }
 
-std::vector<TimedCommand> loadCommandTable(const std::string& path) {
+std::vector<TimedCommand> loadCommandTable(const std::string& path, const CommandCheck& check) {
   std::vector<std::string> problems;
   const std::string text = readTextFile(path, problems);
   if (!problems.empty()) throw ConfigError("command table", problems);
-  return parseCommandTable(text, path);
+  return parseCommandTable(text, path, check);
 }
 
 bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time) {

@@ -58,21 +58,21 @@ int help() {
   return 0;
 }
 
-/// Refuses `commands` (read from `path`) with every problem listed, before anything runs, if the run's
-/// scene refuses any of them.
+/// Refuses a protocol's `commands` (from `path`) with every problem listed, before anything runs, if the
+/// run would refuse any of them.
 void checkCommands(const std::vector<friction::TimedCommand>& commands, const std::string& path,
-                   const friction::Simulation& simulation) {
+                   const friction::CommandCheck& check) {
   std::vector<std::string> problems;
   for (std::size_t k = 0; k < commands.size(); ++k) {
-    const std::string reason = simulation.checkCommand(commands[k]);
-    if (!reason.empty()) {
+    const std::string refusal = check(commands[k]);
+    if (!refusal.empty()) {
       std::ostringstream where;
       where.precision(12);
       where << path << ", command " << k + 1 << " (t = " << commands[k].time << " s): ";
-      problems.push_back(where.str() + reason);
+      problems.push_back(where.str() + refusal);
     }
   }
-  if (!problems.empty()) throw friction::ConfigError("command table", problems);
+  if (!problems.empty()) throw friction::ConfigError("protocol", problems);
 }
 
 int run(int argc, char** argv) {
@@ -112,12 +112,6 @@ int run(int argc, char** argv) {
   for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
   std::vector<friction::TimedCommand> commands;
   const std::string commands_source = commands_path.empty() ? protocol_path : commands_path;
-  if (!commands_path.empty()) {
-    commands = friction::loadCommandTable(commands_path);
-    if (commands.empty()) {
-      std::cerr << "warning: " << commands_path << " holds no commands: the scene's stage program drives the run\n";
-    }
-  }
   if (!protocol_path.empty()) {
     // As the stage controller runs it from t = 0: its schedule, each command at the time its stamp
     // carries, and its end as the run's (set_run_end).
@@ -128,7 +122,15 @@ int run(int argc, char** argv) {
   }
   const auto start = std::chrono::steady_clock::now();
   friction::Simulation simulation(scene, stability_limit);
-  checkCommands(commands, commands_source, simulation);
+  auto check = [&simulation](const friction::TimedCommand& command) { return simulation.checkCommand(command); };
+  if (!commands_path.empty()) {
+    commands = friction::loadCommandTable(commands_path, check);
+    if (commands.empty()) {
+      std::cerr << "warning: " << commands_path << " holds no commands: the scene's stage program drives the run\n";
+    }
+  } else {
+    checkCommands(commands, commands_source, check);
+  }
   if (out_dir.empty()) out_dir = "results/" + scene.name;
   std::error_code directory_error;
   std::filesystem::create_directories(out_dir, directory_error);
