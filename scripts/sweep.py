@@ -109,7 +109,7 @@ def precursors(events):
     for event in events:
         if event["global"] == "1":
             break
-        if not float(event.get("mean_slip_m", "0")) < 0.0:
+        if not float(event.get("mean_slip_m") or "nan") < 0.0:  # a run without the column slid forward
             out.append(event)
     return out
 
@@ -141,8 +141,10 @@ def collect(spec, points, out):
             for row in csv.DictReader(handle):
                 rows.append(dict(point, run=run_id(point), **row))
     if rows:
+        # Every column of every run: a run kept from an older friction_run may lack the newer ones (nan there).
+        columns = list(dict.fromkeys(key for row in rows for key in row))
         with open(os.path.join(out, "events.csv"), "w", newline="") as handle:
-            writer = csv.DictWriter(handle, fieldnames=list(rows[0].keys()))
+            writer = csv.DictWriter(handle, fieldnames=columns, restval="nan")
             writer.writeheader()
             writer.writerows(rows)
     for name in failed:

@@ -124,6 +124,27 @@ TEST(FastForward, AStageAtRestWithNoEndTakesNoEndlessJump) {
   EXPECT_EQ(simulation.time(), 0.01);
 }
 
+TEST(FastForward, AJumpToTheCallersTimeEndsOnItExactly) {
+  // The rig applies a command when its time is at most the clock's, compared exactly: a jump cut at a
+  // command must end on that double, not an ulp short of it (time + (until − time) can be).
+  Simulation simulation(testing::coarseSliderScene(true));
+  simulation.advance(0.0013);
+  ASSERT_EQ(simulation.time(), 0.0013);
+  const double start = simulation.time();
+  double until = 0.0;
+  // Times well beyond twice the start, on an irrational step (a decimal grid's sums round exactly), before
+  // the first event (at 12 ms).
+  for (int k = 1; k < 120000 && until == 0.0; ++k) {
+    const double candidate = 0.003 + k * 0.7071067811865476e-7;
+    if (start + (candidate - start) != candidate) until = candidate;
+  }
+  ASSERT_NE(until, 0.0) << "no time found whose difference does not add back exactly";
+  const long long jumps = simulation.jumps();
+  simulation.advance(until);
+  EXPECT_EQ(simulation.jumps(), jumps + 1);
+  EXPECT_EQ(simulation.time(), until);
+}
+
 TEST(FastForward, AStageTravelLimitEndsTheRunWithinAStepOfIt) {
   // 20 µm of travel comes long before the first precursor (about 55 µm): a jump toward that threshold
   // would pass the limit by micrometres if it were cut only at the time limit.

@@ -148,6 +148,17 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         status, message = self.refusal(SCENE, "--out", self.out, "--protocol", protocol, "--commands", protocol)
         self.assertEqual(status, 2)
         self.assertIn("--commands and --protocol both drive the stage; give one", message)
+        # What the scene refuses, named by the protocol's step, once for a whole ramp.
+        with open(protocol, "w") as handle:
+            handle.write("steps:\n"
+                         "  - {action: normal_load, normal_force: 1.0e9, ramp_time: 0.01}\n"
+                         "  - {action: drive, speed: 2.0, duration: .inf}\n"
+                         "end: {global_events: 1}\n")
+        status, message = self.refusal(SCENE, "--out", self.out, "--protocol", protocol)
+        self.assertEqual(status, 3)
+        self.assertIn("protocol refused (2 problems)", message)
+        self.assertIn("%s, steps[0]: normal load 1e+09 N is not allowed" % protocol, message)
+        self.assertIn("%s, steps[1]: speed 2 m/s exceeds the stage's max_speed 1 m/s" % protocol, message)
 
 
 if __name__ == "__main__":

@@ -34,12 +34,12 @@ def event(index, onset, shear_ratio, rupture_length, slider_length=0.14):
 
 
 def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None, normal_load_rise=0.0,
-              commands=True, scene_again=None, resets=0):
+              commands=True, scene_again=None, resets=0, first_resets=0):
     """Load cells and frames for 0.1 s (F_Z rising by `normal_load_rise` N per ms), two events from the
     simulator and, unless not `detector`, the same two, with the detector's slightly later reading of F_X,
     from the detector; `also` another rig's namespace with the same; unless not `commands`, a drive and a
     normal-load command as applied; `scene_again` a second scene message (the rig's with its run end);
-    stage states counting `resets`."""
+    stage states counting `resets` during the recording, from `first_resets` before it."""
     if also:
         write_bag(path + ".also", also, detector, slider_length)
     with rosbag.Bag(path, "w") as bag:
@@ -50,9 +50,10 @@ def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=No
         bag.write(namespace + "/scene", String(data=SCENE), rospy.Time(0, 1))
         if scene_again:
             bag.write(namespace + "/scene", String(data=scene_again), rospy.Time(0, 2))
-        state = StageState(resets=resets)
-        state.header.stamp = rospy.Time.from_sec(0.05)
-        bag.write(namespace + "/stage_state", state, state.header.stamp)
+        for stamp, count in [(0.01, first_resets), (0.05, first_resets + resets)]:
+            state = StageState(resets=count)
+            state.header.stamp = rospy.Time.from_sec(stamp)
+            bag.write(namespace + "/stage_state", state, state.header.stamp)
         if commands:
             drive = StageCommand(mode=StageCommand.VELOCITY, speed=4e-4, target=0.5, normal_force=7.0)
             bag.write(namespace + "/applied_commands", drive, rospy.Time(0, 2))
@@ -134,6 +135,11 @@ class RigReportTest(unittest.TestCase):
         self.assertEqual(done.returncode, 0, done.stderr)
         self.assertIn("the bag spans 1 reset(s): it holds 2 runs on one time axis", done.stdout)
         self.assertNotIn("friction_run", done.stdout)
+        # One recorded after an earlier reset holds one run.
+        write_bag(self.bag, first_resets=1)
+        done = self.report()
+        self.assertNotIn("reset", done.stdout)
+        self.assertIn("friction_run", done.stdout)
 
     def test_the_detectors_events_on_request(self):
         done = self.report("--events", "detector")

@@ -30,7 +30,8 @@ enum class EventKind { Precursor = 0, SingleNodeSlip = 1, AfterGlobal = 2, Globa
 /// A global event ran over the whole interface. The others before the first global event are precursors,
 /// and those with L_p = 0 single nodes slipping alone (no front ran), as the runner's summary
 /// (results_io.cpp) and rig_report count them, except the back-slips, in which the interface slid against
-/// x (SlipEvent.mean_slip < 0, as where the stage draws back); those after it arrested in a later
+/// x (SlipEvent.mean_slip < 0: where the stage draws back, or beside a trailing corner that lifts off);
+/// those after it arrested in a later
 /// stick–slip cycle, on an interface the global slip has left stressed differently.
 EventKind eventKind(bool global_event, double rupture_length, bool after_a_global_event, bool back_slip);
 

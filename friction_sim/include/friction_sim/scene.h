@@ -118,9 +118,10 @@ struct StopSpec {
   double stage_travel = std::numeric_limits<double>::infinity();  ///< m, stop after this stage travel
 };
 
-/// Whether `stop` has a condition that ends a run: a count of global events, or a finite time or travel.
+/// Whether `stop` has a condition that ends a run: a count of global events, or a finite time or travel
+/// (a negative count is refused on its own, not also as no condition).
 inline bool endsTheRun(const StopSpec& stop) {
-  return stop.global_events > 0 || stop.time < std::numeric_limits<double>::infinity() ||
+  return stop.global_events != 0 || stop.time < std::numeric_limits<double>::infinity() ||
          stop.stage_travel < std::numeric_limits<double>::infinity();
 }
 /// The refusal of a stop condition that does not (scenes and set_run_end alike).

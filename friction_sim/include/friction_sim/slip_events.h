@@ -48,7 +48,8 @@ struct SlipEvent {
   /// m, mean slip of the nodes that slipped (NaN if none did); negative for a back-slip.
   double meanSlip() const;
   /// The interface slid back, against x (meanSlip() < 0), as where the stage draws back and the shear
-  /// it stored relaxes: an event, but no precursor of sliding, whatever its extent.
+  /// it stored relaxes, or beside a trailing corner that lifts off: an event, but no precursor of
+  /// sliding, whatever its extent (a global one is a global event, slid back as a whole).
   bool backSlip() const { return meanSlip() < 0.0; }
 };
 

@@ -82,9 +82,8 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
   if (!(protocol.end.stage_travel > 0.0)) problem("end.stage_travel", protocol.end.stage_travel, "a travel > 0 m");
   if (!(protocol.end.time > 0.0)) problem("end.time", protocol.end.time, "a time > 0 s");
   if (protocol.ramp_commands < 1) problem("ramp_commands", protocol.ramp_commands, "an integer >= 1");
-  if (protocol.end.global_events == 0 && std::isinf(protocol.end.stage_travel) && std::isinf(protocol.end.time)) {
-    problems.push_back("end: no condition, so the run would never end (a recording one would fill the disk); give "
-                       "global_events, stage_travel or time");
+  if (!endsTheRun(StopSpec{protocol.end.global_events, protocol.end.time, protocol.end.stage_travel})) {
+    problems.push_back(std::string("end: ") + kNoEndProblem);
   }
   if (!problems.empty()) throw ConfigError("protocol", problems);
   return protocol;

@@ -52,7 +52,11 @@ namespace {
 std::string formatNumber(double value) {
   char text[32];
   const auto written = std::to_chars(text, text + sizeof text, value);
-  return std::string(text, written.ptr);
+  std::string number(text, written.ptr);
+  // "3e+09" is a string to YAML 1.1 readers (PyYAML, rosparam): "3.0e+09" is a float to every reader.
+  const auto exponent = number.find('e');
+  if (exponent != std::string::npos && number.find('.') == std::string::npos) number.insert(exponent, ".0");
+  return number;
 }
 
 // The one description of the scene's YAML layout, walked by both the reader and the writer so that

@@ -58,19 +58,31 @@ int help() {
   return 0;
 }
 
-/// Refuses a protocol's `commands` (from `path`) with every problem listed, before anything runs, if the
-/// run would refuse any of them.
-void checkCommands(const std::vector<friction::TimedCommand>& commands, const std::string& path,
+/// Refuses `protocol` (from `path`) with every problem listed, before anything runs, if the run would
+/// refuse what one of its steps acts with: the F_Z a normal_load step reaches (its ramp's steps lie
+/// between the F_Z before and that), the stage command of a drive or move_to.
+void checkProtocol(const friction::LoadingProtocol& protocol, const std::string& path,
                    const friction::CommandCheck& check) {
   std::vector<std::string> problems;
-  for (std::size_t k = 0; k < commands.size(); ++k) {
-    const std::string refusal = check(commands[k]);
-    if (!refusal.empty()) {
-      std::ostringstream where;
-      where.precision(12);
-      where << path << ", command " << k + 1 << " (t = " << commands[k].time << " s): ";
-      problems.push_back(where.str() + refusal);
+  for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
+    const friction::ProtocolStep& step = protocol.steps[i];
+    friction::TimedCommand acts_with;
+    switch (step.action) {
+      case friction::ProtocolAction::NormalLoad:
+        acts_with.kind = friction::TimedCommand::Kind::NormalLoad;
+        acts_with.normal_force = step.normal_force;
+        break;
+      case friction::ProtocolAction::Drive:
+        acts_with.stage = {friction::StageMode::Velocity, step.speed, 0.0};
+        break;
+      case friction::ProtocolAction::MoveTo:
+        acts_with.stage = {friction::StageMode::Position, step.speed, step.target};
+        break;
+      default:
+        continue;  // a hold acts with nothing
     }
+    const std::string refusal = check(acts_with);
+    if (!refusal.empty()) problems.push_back(path + ", steps[" + std::to_string(i) + "]: " + refusal);
   }
   if (!problems.empty()) throw friction::ConfigError("protocol", problems);
 }
@@ -112,10 +124,11 @@ int run(int argc, char** argv) {
   for (const std::string& warning : friction::sceneWarnings(scene)) std::cerr << "warning: " << warning << "\n";
   std::vector<friction::TimedCommand> commands;
   const std::string commands_source = commands_path.empty() ? protocol_path : commands_path;
+  friction::LoadingProtocol protocol;
   if (!protocol_path.empty()) {
     // As the stage controller runs it from t = 0: its schedule, each command at the time its stamp
     // carries, and its end as the run's (set_run_end).
-    const friction::LoadingProtocol protocol = friction::loadProtocol(protocol_path);
+    protocol = friction::loadProtocol(protocol_path);
     commands = friction::scheduleProtocol(protocol, 0.0, scene.load.normal_force);
     for (friction::TimedCommand& command : commands) command.time = friction::stampSeconds(command.time);
     scene.stop = {protocol.end.global_events, protocol.end.time, protocol.end.stage_travel};
@@ -128,8 +141,8 @@ int run(int argc, char** argv) {
     if (commands.empty()) {
       std::cerr << "warning: " << commands_path << " holds no commands: the scene's stage program drives the run\n";
     }
-  } else {
-    checkCommands(commands, commands_source, check);
+  } else if (!protocol_path.empty()) {
+    checkProtocol(protocol, protocol_path, check);
   }
   if (out_dir.empty()) out_dir = "results/" + scene.name;
   std::error_code directory_error;
