@@ -57,6 +57,10 @@ struct TimedCommand {
 LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& source = "");
 LoadingProtocol loadProtocol(const std::string& path);
 
+/// What `step` acts with, at time 0: a normal_load step's final F_Z (its ramp's steps lie between the F_Z
+/// before and that), a hold, drive or move_to step's stage command.
+TimedCommand stepCommand(const ProtocolStep& step);
+
 /// The protocol's commands from `start_time` (s), ramps starting at F_Z = `start_normal_force` (N);
 /// it ends with the first step of infinite duration. The protocol drives the stage from its start: one
 /// that begins with normal_load steps holds the stage until its first stage step (one of normal_load

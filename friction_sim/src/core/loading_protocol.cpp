@@ -96,6 +96,26 @@ LoadingProtocol loadProtocol(const std::string& path) {
   return parseProtocol(text, path);
 }
 
+TimedCommand stepCommand(const ProtocolStep& step) {
+  TimedCommand command;
+  switch (step.action) {
+    case ProtocolAction::NormalLoad:
+      command.kind = TimedCommand::Kind::NormalLoad;
+      command.normal_force = step.normal_force;
+      break;
+    case ProtocolAction::Hold:
+      command.stage = {StageMode::Hold, 0.0, 0.0};
+      break;
+    case ProtocolAction::Drive:
+      command.stage = {StageMode::Velocity, step.speed, 0.0};
+      break;
+    case ProtocolAction::MoveTo:
+      command.stage = {StageMode::Position, step.speed, step.target};
+      break;
+  }
+  return command;
+}
+
 std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, double start_time,
                                            double start_normal_force) {
   std::vector<TimedCommand> schedule;
@@ -123,19 +143,8 @@ std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, doub
       time += step.ramp_time;
       continue;
     }
-    TimedCommand command;
+    TimedCommand command = stepCommand(step);
     command.time = time;
-    switch (step.action) {
-      case ProtocolAction::Hold:
-        command.stage = {StageMode::Hold, 0.0, 0.0};
-        break;
-      case ProtocolAction::Drive:
-        command.stage = {StageMode::Velocity, step.speed, 0.0};
-        break;
-      default:
-        command.stage = {StageMode::Position, step.speed, step.target};
-        break;
-    }
     schedule.push_back(command);
     if (std::isinf(step.duration)) break;
     time += step.duration;

@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <sstream>
 
 #include "friction_sim/command_schedule.h"
 #include "friction_sim/results_io.h"
@@ -59,29 +58,12 @@ int help() {
 }
 
 /// Refuses `protocol` (from `path`) with every problem listed, before anything runs, if the run would
-/// refuse what one of its steps acts with: the F_Z a normal_load step reaches (its ramp's steps lie
-/// between the F_Z before and that), the stage command of a drive or move_to.
+/// refuse what one of its steps acts with (stepCommand).
 void checkProtocol(const friction::LoadingProtocol& protocol, const std::string& path,
                    const friction::CommandCheck& check) {
   std::vector<std::string> problems;
   for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
-    const friction::ProtocolStep& step = protocol.steps[i];
-    friction::TimedCommand acts_with;
-    switch (step.action) {
-      case friction::ProtocolAction::NormalLoad:
-        acts_with.kind = friction::TimedCommand::Kind::NormalLoad;
-        acts_with.normal_force = step.normal_force;
-        break;
-      case friction::ProtocolAction::Drive:
-        acts_with.stage = {friction::StageMode::Velocity, step.speed, 0.0};
-        break;
-      case friction::ProtocolAction::MoveTo:
-        acts_with.stage = {friction::StageMode::Position, step.speed, step.target};
-        break;
-      default:
-        continue;  // a hold acts with nothing
-    }
-    const std::string refusal = check(acts_with);
+    const std::string refusal = check(friction::stepCommand(protocol.steps[i]));
     if (!refusal.empty()) problems.push_back(path + ", steps[" + std::to_string(i) + "]: " + refusal);
   }
   if (!problems.empty()) throw friction::ConfigError("protocol", problems);
