@@ -34,7 +34,7 @@
 #include <memory>
 #include <sstream>
 
-#include "friction_sim/command_schedule.h"
+#include "friction_sim/run_driver.h"
 #include "friction_sim/loading_protocol.h"
 #include "friction_sim/results_io.h"
 #include "friction_sim/ros/conversions.h"
@@ -516,14 +516,13 @@ TEST(FullRun, BagHoldsTheCommandsAsApplied) {
 TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
   // As the simulator node runs: the commands due by now applied before the step, and a fast-forward
   // jump cut only where the next command is due (the instruments are interpolated across it).
-  Simulation offline(launchedScene());
+  const Scene scene = launchedScene();
+  RunDriver driver(scene, requireValidScene(scene));
+  const Simulation& offline = driver.simulation();
   ASSERT_TRUE(offline.scene().integrator.fast_forward);
-  CommandSchedule schedule;
-  for (const TimedCommand& command : launchedSchedule(offline.scene())) schedule.add(command);
-  while (offline.globalEventCount() < 2 && offline.time() < 5.0) {
-    schedule.applyDue(offline, [](const TimedCommand&, const std::string& refusal) { EXPECT_EQ(refusal, ""); });
-    offline.advance(schedule.nextTime());
-  }
+  for (const TimedCommand& command : launchedSchedule(offline.scene())) driver.schedule(command);
+  driver.onCommandDue([](const TimedCommand&, const std::string& refusal) { EXPECT_EQ(refusal, ""); });
+  while (offline.globalEventCount() < 2 && offline.time() < 5.0) driver.advance();
   EXPECT_GT(offline.jumps(), 0);
   // The simulator ends the run itself on the step of the protocol's end (set_run_end), however late the
   // controller hears of it: the live run holds the same events and ends at the same step.

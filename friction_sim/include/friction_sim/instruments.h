@@ -26,6 +26,24 @@ double interpolationWeight(double a_time, double b_time, double t);
 /// the forces are affine in time); the counters are those of `b`.
 LoadCellReading interpolate(const LoadCellReading& a, const LoadCellReading& b, double t);
 
+/// What the stage does at one instant.
+struct StageReading {
+  StageMode mode = StageMode::Hold;
+  double velocity = 0.0;  ///< m/s
+  double target = 0.0;    ///< m, of a move to a position
+  double travel = 0.0;    ///< m, total distance moved
+};
+
+/// The stage state: the load cells (time, stage position, forces) and what the stage does.
+struct StageStateReading {
+  LoadCellReading cells;
+  StageReading stage;
+};
+
+/// The stage state at time t between two readings across a fast-forward jump: the load cells and the
+/// travel linearly; the stage keeps `a`'s motion until `b`'s time (a jump ends where the motion changes).
+StageStateReading interpolate(const StageStateReading& a, const StageStateReading& b, double t);
+
 /// The fast camera's frame: the interface's state per node.
 struct InterfaceFrame {
   double time = 0.0;               ///< s

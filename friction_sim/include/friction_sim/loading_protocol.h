@@ -90,6 +90,14 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
                                             const CommandCheck& check = nullptr);
 std::vector<TimedCommand> loadCommandTable(const std::string& path, const CommandCheck& check = nullptr);
 
+/// The protocol's commands as the stage controller sends them from t = 0, ramps starting at F_Z =
+/// `start_normal_force` (N): each at the time its stamp carries (stampSeconds).
+std::vector<TimedCommand> protocolCommands(const LoadingProtocol& protocol, double start_normal_force);
+
+/// Throws ConfigError listing every step of `protocol` (read from `path`) that `check` refuses what it acts
+/// with (stepCommand), before anything runs.
+void checkProtocolSteps(const LoadingProtocol& protocol, const std::string& path, const CommandCheck& check);
+
 /// True once an end condition of the protocol holds.
 bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time);
 

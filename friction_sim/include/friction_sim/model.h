@@ -81,6 +81,8 @@ class Model {
   virtual int interfaceDof(int node) const = 0;
   /// m, rest x position of interface node `node`.
   virtual double interfacePosition(int node) const = 0;
+  /// m, rest x position of every interface node.
+  std::vector<double> interfacePositions() const;
   /// m², the interface area one node stands for (l·B or a·B), for σ = N/area and τ = f/area.
   virtual double interfaceNodeArea() const = 0;
 

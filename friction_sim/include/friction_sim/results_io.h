@@ -47,5 +47,10 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
 void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,
                         const std::vector<double>& node_positions);
 void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& readings);
+/// stresses.csv, written as the run goes: its header, then per event and `phase` (onset, end) one row per
+/// interface node with the strain gauge above it (NaN where there is none) and the interface's stresses.
+void writeStressesHeader(std::ostream& out);
+void writeStressRows(std::ostream& out, int event, const char* phase, const InterfaceFrame& frame,
+                     const GaugeProfile& gauges);
 
 }  // namespace friction

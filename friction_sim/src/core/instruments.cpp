@@ -52,6 +52,13 @@ LoadCellReading interpolate(const LoadCellReading& a, const LoadCellReading& b, 
   return out;
 }
 
+StageStateReading interpolate(const StageStateReading& a, const StageStateReading& b, double t) {
+  StageStateReading at{interpolate(a.cells, b.cells, t), t < b.cells.time ? a.stage : b.stage};
+  const double w = interpolationWeight(a.cells.time, b.cells.time, t);
+  at.stage.travel = a.stage.travel + w * (b.stage.travel - a.stage.travel);
+  return at;
+}
+
 GaugeProfile interpolate(const GaugeProfile& a, const GaugeProfile& b, double t) {
   auto [out, w] = startAt(a, b, t);
   blend(a.stress, out.stress, w);

@@ -295,4 +295,19 @@ bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_trave
          elapsed_time >= end.time;
 }
 
+std::vector<TimedCommand> protocolCommands(const LoadingProtocol& protocol, double start_normal_force) {
+  std::vector<TimedCommand> commands = scheduleProtocol(protocol, 0.0, start_normal_force);
+  for (TimedCommand& command : commands) command.time = stampSeconds(command.time);
+  return commands;
+}
+
+void checkProtocolSteps(const LoadingProtocol& protocol, const std::string& path, const CommandCheck& check) {
+  std::vector<std::string> problems;
+  for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
+    const std::string refusal = check(stepCommand(protocol.steps[i]));
+    if (!refusal.empty()) problems.push_back(path + ", steps[" + std::to_string(i) + "]: " + refusal);
+  }
+  if (!problems.empty()) throw ConfigError("protocol", problems);
+}
+
 }  // namespace friction

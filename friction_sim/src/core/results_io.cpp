@@ -104,4 +104,21 @@ void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& read
   }
 }
 
+void writeStressesHeader(std::ostream& out) {
+  out << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
+         "interface_normal_stress_Pa,interface_shear_stress_Pa\n";
+  out.precision(10);
+}
+
+void writeStressRows(std::ostream& out, int event, const char* phase, const InterfaceFrame& frame,
+                     const GaugeProfile& gauges) {
+  for (std::size_t i = 0; i < frame.position.size(); ++i) {
+    const bool gauge = i < gauges.stress.sigma_zz.size() && gauges.position[i] == frame.position[i];
+    out << event << ',' << phase << ',' << frame.time << ',' << frame.position[i] << ','
+        << (gauge ? gauges.stress.sigma_xx[i] : NAN) << ',' << (gauge ? gauges.stress.sigma_zz[i] : NAN) << ','
+        << (gauge ? gauges.stress.tau_xz[i] : NAN) << ',' << frame.normal_stress[i] << ',' << frame.shear_stress[i]
+        << '\n';
+  }
+}
+
 }  // namespace friction

@@ -78,10 +78,9 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/command_schedule.h"
 #include "friction_sim/loading_protocol.h"
 #include "friction_sim/ros/conversions.h"
-#include "friction_sim/simulation.h"
+#include "friction_sim/run_driver.h"
 
 namespace friction {
 
@@ -128,33 +127,15 @@ class RigSimulator {
   void startSimulation();
   /// The scene as it runs now (its stop condition set_run_end's, if called) on `scene` and in the bag.
   void publishScene();
-  void publishInstruments();
-  /// What the stage does at one instant.
-  struct StageReading {
-    StageMode mode = StageMode::Hold;
-    double velocity = 0.0;  ///< m/s
-    double target = 0.0;    ///< m, of a move to a position
-    double travel = 0.0;    ///< m, total distance moved
-  };
-  StageReading stageReading() const;
-  /// Every instrument's reading at one instant.
-  struct Readings {
-    LoadCellReading cells;
-    GaugeProfile gauges;  ///< empty for the chain
-    InterfaceFrame frame;
-    LatticeSnapshot lattice;
-    StageReading stage;
-  };
-  Readings readings() const;
-  /// After a fast-forward jump: every instrument's reading at every publication time the jump passed,
-  /// interpolated from `before` the jump and after it (along a jump the statics are nearly affine in time).
-  void publishAcrossJump(const Readings& before);
+  /// The instruments' streams of a new run, each publishing to its topic.
+  void addStreams(RunDriver& driver);
+  /// A lattice snapshot at the wall-clock rate for live viewers, when the bag's clock gave none.
+  void publishLiveSnapshot();
   void publishClock(double time);
-  /// The stage state from the load cells' time, position and forces and what the stage did then.
-  void publishStageState(const LoadCellReading& cells, const StageReading& stage);
+  void publishStageState(const StageStateReading& reading);
   /// The stage state now.
   void publishStageState();
-  void applyDueCommands();
+  void publishAppliedCommand(const TimedCommand& command, const std::string& refusal);
   std::string accept(const friction_msgs::StageCommand& msg);
   void onCommand(const friction_msgs::StageCommand::ConstPtr& msg);
   bool onSendCommand(friction_msgs::SendStageCommand::Request& request,
@@ -176,22 +157,20 @@ class RigSimulator {
   SimulatorOptions options_;
   Scene scene_;
   double stability_limit_ = 0.0;  ///< s, of scene_, from its validation
-  std::unique_ptr<Simulation> simulation_;
+  const Simulation& simulation() const { return driver_->simulation(); }
+  std::unique_ptr<RunDriver> driver_;  ///< the run since the start or the last reset
+  const SampledStream<LatticeSnapshot>* lattice_stream_ = nullptr;  ///< driver_'s
   std::vector<double> interface_positions_;
   WaveSpeeds wave_speeds_;
-  CommandSchedule pending_;  ///< accepted commands, due at their simulated times
   rosbag::Bag bag_;
   bool bag_open_ = false;
   bool paused_ = false;
   bool stop_ = false;
   bool aborted_ = false;
   bool reset_requested_ = false;
-  bool run_end_set_ = false;  ///< set_run_end was called: the run ends when the simulation finishes
   int scenes_recorded_ = 0;    ///< scene messages written to the bag
   std::uint32_t resets_ = 0;  ///< resets so far, in stage_state: a controller cannot always tell one by the time
   std::uint32_t frame_index_ = 0;
-  double next_load_cells_ = 0, next_gauges_ = 0, next_frame_ = 0, next_stage_state_ = 0, next_clock_ = 0,
-         next_lattice_ = 0;
   ros::WallTime next_snapshot_, pace_origin_wall_;
   double running_wall_time_ = 0.0;  ///< s, wall time spent running before running_since_
   ros::WallTime running_since_;     ///< when the simulation last began running (unpaused)

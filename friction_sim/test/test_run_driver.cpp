@@ -1,0 +1,161 @@
+// The run driver: the one loop of the offline runner, the simulator node and the tests. Its streams
+// sample on their own clocks and never change the run; its commands and run end act as the rig's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "friction_sim/run_driver.h"
+#include "test_helpers.h"
+
+namespace friction::testing {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// The single block pushed at V = 0.4 mm/s through K = 4 MN/m under F_Z = 1920 N, µ_s = 0.4: stuck, F_X =
+/// K·V·t until K·V·t = µ_s·F_Z at t = 0.48 s (MODEL.md §7.1).
+Scene blockScene(bool fast_forward, double stop_time) {
+  Scene scene = loadScene(scenePath("single_block"));
+  scene.integrator.fast_forward = fast_forward;
+  scene.stop.time = stop_time;
+  return scene;
+}
+constexpr double kStageStiffness = 4.0e6, kStageSpeed = 4.0e-4, kFirstSlip = 0.4 * 1920.0 / (4.0e6 * 4.0e-4);
+
+/// Every stream the simulator node registers, each counting what it receives.
+struct Counts {
+  int clock = 0, cells = 0, gauges = 0, frames = 0, started = 0, ended = 0, stage = 0, lattice = 0;
+};
+void addEveryStream(RunDriver& driver, Counts& counts) {
+  driver.add(std::make_unique<SampledStream<Instant>>(
+      1e4, Sampling::AtSteps, [](const Simulation& s) { return Instant{s.time()}; },
+      [&counts](const Instant&) { ++counts.clock; }));
+  driver.add(std::make_unique<SampledStream<LoadCellReading>>(
+      1e4, Sampling::AtSteps, [](const Simulation& s) { return s.loadCells(); },
+      [&counts](const LoadCellReading&) { ++counts.cells; }, true));
+  driver.add(std::make_unique<SampledStream<GaugeProfile>>(
+      1e4, Sampling::AtSteps, [](const Simulation& s) { return s.gaugeProfile(); },
+      [&counts](const GaugeProfile&) { ++counts.gauges; }));
+  driver.add(std::make_unique<CameraStream>(1e5, 100.0, [&counts](const InterfaceFrame&) { ++counts.frames; }));
+  driver.add(std::make_unique<EventStream>([&counts](const Simulation&) { ++counts.started; },
+                                           [&counts](const Simulation&, const SlipEvent&) { ++counts.ended; }));
+  driver.add(std::make_unique<SampledStream<StageStateReading>>(
+      1e3, Sampling::AtSteps, stageState, [&counts](const StageStateReading&) { ++counts.stage; }));
+  driver.add(std::make_unique<SampledStream<LatticeSnapshot>>(
+      200.0, Sampling::AtSteps, [](const Simulation& s) { return s.snapshot(); },
+      [&counts](const LatticeSnapshot&) { ++counts.lattice; }));
+}
+
+TEST(RunDriver, StreamsNeverChangeTheRun) {
+  // The simulator node's streams against none, on a 2D slider with fast-forward to its first global
+  // event: the same state to the last bit, and the same events.
+  const Scene scene = coarseSliderScene(true);
+  const double limit = requireValidScene(scene);
+  RunDriver bare(scene, limit), watched(scene, limit);
+  Counts counts;
+  addEveryStream(watched, counts);
+  bare.run();
+  watched.run();
+  EXPECT_GT(watched.simulation().jumps(), 0);
+  EXPECT_EQ(watched.simulation().stateHash(), bare.simulation().stateHash());
+  ASSERT_EQ(watched.simulation().events().size(), bare.simulation().events().size());
+  const double t = watched.simulation().time();
+  // Each clock's samples: one per period up to the end, none at t = 0.
+  EXPECT_EQ(counts.clock, static_cast<int>(std::floor(t * 1e4 + 1e-9)));
+  EXPECT_EQ(counts.stage, static_cast<int>(std::floor(t * 1e3 + 1e-9)));
+  EXPECT_EQ(counts.lattice, static_cast<int>(std::floor(t * 200.0 + 1e-9)));
+  EXPECT_EQ(counts.gauges, counts.clock);
+  // The load cells also at each event's first and last step.
+  const int events = static_cast<int>(watched.simulation().events().size());
+  EXPECT_GE(counts.cells, counts.clock + events);
+  EXPECT_LE(counts.cells, counts.clock + 2 * events);
+  EXPECT_EQ(counts.started, events);
+  EXPECT_EQ(counts.ended, events);
+  EXPECT_GE(counts.frames, static_cast<int>(std::floor(t * 100.0 + 1e-9)));
+}
+
+TEST(RunDriver, InterpolatedSamplesLieOnTheirClockAndOnTheLoadingLine) {
+  // Fast-forward jumps from t = 0 to just before the first slip: the samples across them lie on
+  // F_X = K·V·t, at k milliseconds.
+  RunDriver driver(blockScene(true, 0.4005), requireValidScene(blockScene(true, 0.4005)));
+  std::vector<LoadCellReading> samples;
+  driver.add(std::make_unique<SampledStream<LoadCellReading>>(
+      1e3, Sampling::Interpolated, [](const Simulation& s) { return s.loadCells(); },
+      [&samples](const LoadCellReading& reading) { samples.push_back(reading); }));
+  driver.run();
+  EXPECT_GT(driver.simulation().jumps(), 0);
+  ASSERT_EQ(samples.size(), 400U);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const double t = (k + 1) * 1e-3;
+    EXPECT_NEAR(samples[k].time, t, 1e-12);
+    EXPECT_NEAR(samples[k].shear_force, kStageStiffness * kStageSpeed * samples[k].time, 1e-9 * 640.0) << t;
+  }
+}
+
+TEST(RunDriver, SamplesAtStepsComeAtTheFirstStepEndOnOrAfterTheirTime) {
+  const Scene scene = blockScene(false, 0.01);
+  RunDriver driver(scene, requireValidScene(scene));
+  std::vector<double> times;
+  driver.add(std::make_unique<SampledStream<Instant>>(
+      1e3, Sampling::AtSteps, [](const Simulation& s) { return Instant{s.time()}; },
+      [&times](const Instant& instant) { times.push_back(instant.time); }));
+  driver.run();
+  ASSERT_EQ(times.size(), 10U);
+  for (std::size_t k = 0; k < times.size(); ++k) {
+    const double due = (k + 1) * 1e-3;
+    EXPECT_GE(times[k], due - 1e-12);
+    EXPECT_LT(times[k], due + scene.integrator.time_step);
+  }
+}
+
+TEST(RunDriver, PacedRunsEndTheirJumpsAtTheCamerasFrames) {
+  // Cut at frames, every idle frame of the stuck block is a jump's end, at its time on the clock; uncut,
+  // one jump covers the whole 0.1 s and its frames are interpolated.
+  const Scene scene = blockScene(true, 0.1);
+  for (bool cut : {false, true}) {
+    RunOptions options;
+    options.cut_jumps_at_frames = cut;
+    RunDriver driver(scene, requireValidScene(scene), options);
+    std::vector<InterfaceFrame> frames;
+    driver.add(std::make_unique<CameraStream>(1e5, 100.0, [&frames](const InterfaceFrame& f) { frames.push_back(f); }));
+    driver.run();
+    ASSERT_EQ(frames.size(), 10U) << cut;
+    for (std::size_t k = 0; k < frames.size(); ++k) EXPECT_NEAR(frames[k].time, (k + 1) * 0.01, 1e-12);
+    if (cut) {
+      EXPECT_GE(driver.simulation().jumps(), 10);
+    } else {
+      EXPECT_LT(driver.simulation().jumps(), 10);
+    }
+  }
+}
+
+TEST(RunDriver, CommandsActWhenDueAndTheRunEndsAtTheRunEndSet) {
+  // Without the scene's end, the run ends only at the end set: the first global event, whose onset is
+  // where K·V·(t − t₀) = µ_s·F_Z for a stage started at t₀ = 0.1 s by a command.
+  Scene scene = blockScene(false, 5.0);
+  scene.stage.program = {StageSegment{StageMode::Hold, 0.0}};
+  RunOptions options;
+  options.stop_at_scene_end = false;
+  RunDriver driver(scene, requireValidScene(scene), options);
+  TimedCommand start;
+  start.time = 0.1;
+  start.stage = {StageMode::Velocity, kStageSpeed, 0.0};
+  driver.schedule(start);
+  std::vector<double> applied_at;
+  driver.onCommandDue([&](const TimedCommand&, const std::string& refusal) {
+    EXPECT_EQ(refusal, "");
+    applied_at.push_back(driver.simulation().time());
+  });
+  EXPECT_EQ(driver.setRunEnd({1, kInf, kInf}), "");
+  EXPECT_NE(driver.setRunEnd({-1, kInf, kInf}), "");
+  driver.run();
+  ASSERT_EQ(applied_at.size(), 1U);
+  EXPECT_NEAR(applied_at[0], 0.1, 1e-12);
+  ASSERT_EQ(driver.simulation().events().size(), 1U);
+  EXPECT_NEAR(driver.simulation().events()[0].onset_time, 0.1 + kFirstSlip, 2.0 * scene.integrator.time_step);
+}
+
+}  // namespace
+}  // namespace friction::testing
