@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/integrator.h"
-#include "friction_sim/scene_io.h"
-#include "friction_sim/simulation.h"
+#include "friction_sim/solvers/integrator.h"
+#include "friction_sim/scene/scene_io.h"
+#include "friction_sim/run/simulation.h"
 
 namespace friction {
 namespace {

@@ -34,13 +34,13 @@
 #include <memory>
 #include <sstream>
 
-#include "friction_sim/run_driver.h"
-#include "friction_sim/loading_protocol.h"
-#include "friction_sim/results_io.h"
+#include "friction_sim/run/run_driver.h"
+#include "friction_sim/scene/loading_protocol.h"
+#include "friction_sim/instruments/results_io.h"
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
-#include "friction_sim/scene_io.h"
-#include "friction_sim/simulation.h"
+#include "friction_sim/scene/scene_io.h"
+#include "friction_sim/run/simulation.h"
 
 namespace friction {
 namespace {

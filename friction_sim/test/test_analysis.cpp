@@ -6,11 +6,11 @@
 #include <cmath>
 #include <limits>
 
-#include "friction_sim/command_schedule.h"
-#include "friction_sim/frame_event_detector.h"
-#include "friction_sim/loading_protocol.h"
-#include "friction_sim/results_io.h"
-#include "friction_sim/simulation.h"
+#include "friction_sim/run/command_schedule.h"
+#include "friction_sim/instruments/frame_event_detector.h"
+#include "friction_sim/scene/loading_protocol.h"
+#include "friction_sim/instruments/results_io.h"
+#include "friction_sim/run/simulation.h"
 #include "test_helpers.h"
 
 namespace friction {

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <vector>
 
-#include "friction_sim/chain_1d.h"
-#include "friction_sim/lattice_2d.h"
-#include "friction_sim/integrator.h"
-#include "friction_sim/simulation.h"
+#include "friction_sim/model/chain_1d.h"
+#include "friction_sim/model/lattice_2d.h"
+#include "friction_sim/solvers/integrator.h"
+#include "friction_sim/run/simulation.h"
 #include "test_helpers.h"
 
 namespace friction {

@@ -8,8 +8,8 @@
 #include "friction_sim/ros/precursor_detector.h"
 #include "friction_sim/ros/rig_simulator.h"
 #include "friction_sim/ros/stage_controller.h"
-#include "friction_sim/scene_io.h"
-#include "friction_sim/yaml_fields.h"
+#include "friction_sim/scene/scene_io.h"
+#include "friction_sim/scene/config_error.h"
 
 namespace friction {
 namespace {
@@ -126,7 +126,9 @@ TEST(Conversions, AStampCarriesTheTimeTheCoreRoundsCommandsTo) {
   // a ramp's staircase, a time that rounds up into the next second and a time off the nanosecond grid.
   for (const double t : {0.0, 0.00025 * 3, 0.001, 0.1300002, 0.4006564345821, 1.9999999996, 16.022026744912, 1e-10}) {
     EXPECT_EQ(stampSeconds(t), ros::Time(t).toSec()) << t;
-    EXPECT_EQ(stampSeconds(t), fromMsg(toMsg(TimedCommand{t})).time) << t;
+    TimedCommand command;
+    command.time = t;
+    EXPECT_EQ(stampSeconds(t), fromMsg(toMsg(command)).time) << t;
   }
 }
 

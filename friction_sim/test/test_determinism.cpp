@@ -8,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "friction_sim/results_io.h"
-#include "friction_sim/run_driver.h"
+#include "friction_sim/instruments/results_io.h"
+#include "friction_sim/run/run_driver.h"
 #include "test_helpers.h"
 
 namespace friction::testing {

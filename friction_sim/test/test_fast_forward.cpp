@@ -6,7 +6,7 @@
 #include <limits>
 #include <vector>
 
-#include "friction_sim/simulation.h"
+#include "friction_sim/run/simulation.h"
 #include "test_helpers.h"
 
 namespace friction {

@@ -2,8 +2,8 @@
 // crossing, weakening over ξ_µ, loss and return of contact, the elastic anchor k_T.
 #include <gtest/gtest.h>
 
-#include "friction_sim/chain_1d.h"
-#include "friction_sim/contact_interface.h"
+#include "friction_sim/model/chain_1d.h"
+#include "friction_sim/contact/contact_interface.h"
 
 namespace friction {
 namespace {

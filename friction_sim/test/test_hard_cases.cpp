@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/integrator.h"
-#include "friction_sim/simulation.h"
+#include "friction_sim/solvers/integrator.h"
+#include "friction_sim/run/simulation.h"
 #include "test_helpers.h"
 
 namespace friction {

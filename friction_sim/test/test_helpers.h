@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/integrator.h"
-#include "friction_sim/model.h"
-#include "friction_sim/scene.h"
-#include "friction_sim/scene_io.h"
+#include "friction_sim/solvers/integrator.h"
+#include "friction_sim/model/model.h"
+#include "friction_sim/scene/scene.h"
+#include "friction_sim/scene/scene_io.h"
 
 namespace friction::testing {
 

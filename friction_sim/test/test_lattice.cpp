@@ -7,10 +7,10 @@
 #include <cmath>
 #include <map>
 
-#include "friction_sim/integrator.h"
-#include "friction_sim/lattice_2d.h"
-#include "friction_sim/simulation.h"
-#include "friction_sim/slip_events.h"
+#include "friction_sim/solvers/integrator.h"
+#include "friction_sim/model/lattice_2d.h"
+#include "friction_sim/run/simulation.h"
+#include "friction_sim/instruments/slip_events.h"
 #include "test_helpers.h"
 
 namespace friction {

@@ -6,7 +6,7 @@
 #include <limits>
 #include <vector>
 
-#include "friction_sim/run_driver.h"
+#include "friction_sim/run/run_driver.h"
 #include "test_helpers.h"
 
 namespace friction::testing {

@@ -8,8 +8,8 @@
 #include <limits>
 #include <sstream>
 
-#include "friction_sim/results_io.h"
-#include "friction_sim/simulation.h"
+#include "friction_sim/instruments/results_io.h"
+#include "friction_sim/run/simulation.h"
 #include "test_helpers.h"
 
 namespace friction {

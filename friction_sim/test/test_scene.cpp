@@ -8,9 +8,9 @@
 #include <fstream>
 #include <limits>
 
-#include "friction_sim/integrator.h"
-#include "friction_sim/scene_io.h"
-#include "friction_sim/simulation.h"
+#include "friction_sim/solvers/integrator.h"
+#include "friction_sim/scene/scene_io.h"
+#include "friction_sim/run/simulation.h"
 #include "test_helpers.h"
 
 namespace friction {
@@ -97,7 +97,9 @@ TEST_P(InvalidScene, IsRefusedNamingFieldValueAndRange) {
   EXPECT_NE(problems[0].find(GetParam().allowed), std::string::npos) << problems[0];
   // A problem of the model's fields also says that dt is still to be checked; nothing else is listed.
   ASSERT_LE(problems.size(), 2u) << problems[1];
-  if (problems.size() == 2) EXPECT_NE(problems[1].find("integrator.time_step: value 2e-07 not yet checked"), std::string::npos);
+  if (problems.size() == 2) {
+    EXPECT_NE(problems[1].find("integrator.time_step: value 2e-07 not yet checked"), std::string::npos);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(

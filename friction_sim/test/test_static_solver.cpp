@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "friction_sim/static_solver.h"
+#include "friction_sim/solvers/static_solver.h"
 #include "test_helpers.h"
 
 namespace friction {

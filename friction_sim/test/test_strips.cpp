@@ -7,8 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
-#include "friction_sim/chain_1d.h"
-#include "friction_sim/lattice_2d.h"
+#include "friction_sim/model/chain_1d.h"
+#include "friction_sim/model/lattice_2d.h"
 #include "test_helpers.h"
 
 namespace friction {
@@ -140,7 +140,9 @@ void expectSuccessiveSweepsGiveSuccessiveEvaluations(const Model& model, const V
       int asked = 0;
       const int evaluated = model.evaluateSuccessiveInStrips(strip_nodes, [&](int k) -> std::optional<StripEvaluation> {
         EXPECT_EQ(k, asked++);
-        if (k > 0) EXPECT_TRUE((interfaceOf(a_together).array() == interfaceOf(a_after[k - 1]).array()).all());
+        if (k > 0) {
+          EXPECT_TRUE((interfaceOf(a_together).array() == interfaceOf(a_after[k - 1]).array()).all());
+        }
         if (k == count) return std::nullopt;
         return StripEvaluation{u_together, v_together, stage(k), a_together, together[k], passes};
       });

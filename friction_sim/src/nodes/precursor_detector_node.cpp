@@ -2,7 +2,7 @@
 #include <iostream>
 
 #include "friction_sim/ros/precursor_detector.h"
-#include "friction_sim/yaml_fields.h"
+#include "friction_sim/scene/config_error.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "precursor_detector");

@@ -3,7 +3,7 @@
 #include <iostream>
 
 #include "friction_sim/ros/rig_simulator.h"
-#include "friction_sim/yaml_fields.h"
+#include "friction_sim/scene/config_error.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "rig_simulator", ros::init_options::NoSigintHandler);

@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-#include "friction_sim/yaml_fields.h"
+#include "friction_sim/scene/config_error.h"
 
 namespace friction {
 

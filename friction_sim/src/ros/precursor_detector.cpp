@@ -2,8 +2,8 @@
 
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
-#include "friction_sim/scene_io.h"
-#include "friction_sim/yaml_fields.h"
+#include "friction_sim/scene/scene_io.h"
+#include "friction_sim/scene/config_error.h"
 
 namespace friction {
 

@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "friction_sim/ros/node_parameters.h"
-#include "friction_sim/results_io.h"
-#include "friction_sim/scene_io.h"
+#include "friction_sim/instruments/results_io.h"
+#include "friction_sim/scene/scene_io.h"
 
 namespace friction {
 

@@ -10,7 +10,7 @@
 
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
-#include "friction_sim/yaml_fields.h"
+#include "friction_sim/scene/config_error.h"
 
 namespace friction {
 

@@ -8,9 +8,9 @@
 #include <map>
 #include <optional>
 
-#include "friction_sim/results_io.h"
-#include "friction_sim/run_driver.h"
-#include "friction_sim/scene_io.h"
+#include "friction_sim/instruments/results_io.h"
+#include "friction_sim/run/run_driver.h"
+#include "friction_sim/scene/scene_io.h"
 
 namespace {
 

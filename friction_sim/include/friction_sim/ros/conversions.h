@@ -14,10 +14,10 @@
 
 #include <string>
 
-#include "friction_sim/instruments.h"
-#include "friction_sim/loading_protocol.h"
-#include "friction_sim/slip_events.h"
-#include "friction_sim/stage.h"
+#include "friction_sim/instruments/instruments.h"
+#include "friction_sim/scene/loading_protocol.h"
+#include "friction_sim/instruments/slip_events.h"
+#include "friction_sim/stage/stage.h"
 
 namespace friction {
 

@@ -37,8 +37,8 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/frame_event_detector.h"
-#include "friction_sim/slip_events.h"
+#include "friction_sim/instruments/frame_event_detector.h"
+#include "friction_sim/instruments/slip_events.h"
 
 namespace friction {
 

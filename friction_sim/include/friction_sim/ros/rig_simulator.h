@@ -78,9 +78,9 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/loading_protocol.h"
+#include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/ros/conversions.h"
-#include "friction_sim/run_driver.h"
+#include "friction_sim/run/run_driver.h"
 
 namespace friction {
 

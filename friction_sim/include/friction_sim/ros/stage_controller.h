@@ -34,7 +34,7 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/loading_protocol.h"
+#include "friction_sim/scene/loading_protocol.h"
 
 namespace friction {
 

@@ -1,0 +1,74 @@
+# The ROS-free core: the library friction_sim_core, the offline runner and the core's tests' sources.
+# Included by CMakeLists.txt both in a catkin build and in a plain CMake build (FRICTION_SIM_CORE_ONLY).
+find_package(Eigen3 REQUIRED)
+find_package(yaml-cpp REQUIRED)
+# CHOLMOD (SuiteSparse): supernodal Cholesky with nested-dissection ordering keeps the static solves of
+# large lattices within memory (Eigen's simplicial LDLT needed > 3 GB at 10^6 nodes).
+find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+
+add_library(friction_sim_core
+  src/core/contact/contact_interface.cpp
+  src/core/contact/friction_law.cpp
+  src/core/instruments/frame_event_detector.cpp
+  src/core/instruments/instruments.cpp
+  src/core/instruments/results_io.cpp
+  src/core/instruments/slip_events.cpp
+  src/core/model/chain_1d.cpp
+  src/core/model/lattice_2d.cpp
+  src/core/model/model.cpp
+  src/core/run/command_schedule.cpp
+  src/core/run/run_driver.cpp
+  src/core/run/simulation.cpp
+  src/core/scene/config_error.cpp
+  src/core/scene/loading_protocol.cpp
+  src/core/scene/scene_io.cpp
+  src/core/scene/scene_validation.cpp
+  src/core/solvers/grid_multigrid.cpp
+  src/core/solvers/integrator.cpp
+  src/core/solvers/static_solver.cpp
+  src/core/stage/stage.cpp
+)
+# Public headers in include/friction_sim/<room>/, the core's own next to its sources (src/core/<room>/).
+target_include_directories(friction_sim_core PUBLIC include PRIVATE src/core)
+target_include_directories(friction_sim_core SYSTEM PUBLIC ${EIGEN3_INCLUDE_DIR} ${CHOLMOD_INCLUDE_DIR})
+# errno from sqrt is never read: without it the bond loops vectorise. No FMA contraction: a vector
+# loop's peeled and main parts would otherwise round differently depending on where a buffer happens
+# to be aligned, and two runs of one scene would drift apart (determinism is tested). No semantic
+# interposition: calls within a source file (the step's small calls) need not go through the PLT and
+# can be inlined; nobody replaces the core's functions at load time.
+target_compile_options(friction_sim_core PRIVATE -fno-math-errno -ffp-contract=off -fno-semantic-interposition)
+# The rig is built where it runs: use the machine's full SIMD width (AVX2/AVX-512 halves the step time).
+option(FRICTION_SIM_NATIVE "Compile the physics core for the building machine's CPU (-march=native)" ON)
+if(FRICTION_SIM_NATIVE)
+  target_compile_options(friction_sim_core PUBLIC -march=native)
+endif()
+# The friction loop records each node's force as it turns it into an acceleration; GCC would split
+# that record off into a memcpy call, a second pass over the forces and a call per strip.
+set_source_files_properties(src/core/contact/contact_interface.cpp PROPERTIES COMPILE_OPTIONS -fno-tree-loop-distribute-patterns)
+target_link_libraries(friction_sim_core PUBLIC yaml-cpp ${CHOLMOD_LIBRARY})
+# Calls between the core's own source files bind inside the library too, without the PLT.
+target_link_options(friction_sim_core PRIVATE -Wl,-Bsymbolic-functions)
+
+add_executable(friction_run src/tools/friction_run.cpp)
+target_link_libraries(friction_run friction_sim_core)
+
+# The core's unit tests (GoogleTest), run by catkin or by CTest.
+set(FRICTION_SIM_CORE_TESTS
+  test/test_analysis.cpp
+  test/test_closed_forms.cpp
+  test/test_determinism.cpp
+  test/test_run_driver.cpp
+  test/test_fast_forward.cpp
+  test/test_hard_cases.cpp
+  test/test_friction_laws.cpp
+  test/test_lattice.cpp
+  test/test_scene.cpp
+  test/test_static_solver.cpp
+  test/test_strips.cpp
+  test/test_runs.cpp
+)
+# Where the core's tests find the shipped scenes and the pinned results.
+set(FRICTION_SIM_CORE_TEST_DEFINITIONS
+  SCENE_DIR="${CMAKE_CURRENT_SOURCE_DIR}/scenes"
+  PINNED_DIR="${CMAKE_CURRENT_SOURCE_DIR}/test/pinned")

@@ -1,0 +1,138 @@
+// The 2D ("1+1D") slider of MODEL.md §2: a square lattice of N_x × N_z nodes in the x–z plane with
+// neighbour springs k, diagonal springs k/2, pair damping η, a one-sided foundation k_f under the
+// bottom row, a top load (uniform or spring mattress) and the pusher K on the trailing edge.
+//
+// Degrees of freedom: u = [u_x of every node, u_z of every node], node (i, j) has index j·N_x + i.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "friction_sim/model/model.h"
+
+namespace friction {
+
+/// The row a pusher at `height` (m) above the interface acts on: the nearest of `rows` rows `spacing`
+/// (m) apart.
+int nearestRow(double height, double spacing, int rows);
+
+class Lattice2D : public Model {
+ public:
+  explicit Lattice2D(const Scene& scene);
+
+  int nodesX() const { return nx_; }
+  int nodesZ() const { return nz_; }
+  double spacing() const { return spacing_; }           ///< m, l
+  double springStiffness() const { return k_; }          ///< N/m, k
+  double dampingRate() const { return eta_; }            ///< kg/s, η
+  double foundationStiffness() const { return kf_; }     ///< N/m, k_f
+  int nodeIndex(int i, int j) const { return j * nx_ + i; }
+  int xDof(int node) const { return node; }
+  int zDof(int node) const { return n_ + node; }
+  const std::vector<int>& pushedRows() const { return pushed_rows_; }
+
+  int dofCount() const override { return 2 * n_; }
+  double nodeMass() const override { return mass_; }
+  int interfaceNodeCount() const override { return nx_; }
+  int interfaceDof(int node) const override { return xDof(node); }
+  double interfacePosition(int node) const override { return node * spacing_; }
+  double interfaceNodeArea() const override { return spacing_ * width_; }
+
+  void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                    ForceEvaluation& out) const override;
+  /// Strips of whole rows; the external forces on a row are added before it is finished.
+  void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                        ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const override;
+  /// Each evaluation sweeps a strip or two behind the one before, through that one's finished rows.
+  int evaluateSuccessiveInStrips(int strip_nodes,
+                                 const std::function<std::optional<StripEvaluation>(int)>& next) const override;
+  int successiveEvaluations() const override { return kSuccessiveSweeps; }
+  /// The foundation's force k_f·(−u_z) on each bottom node.
+  Vector signedNormalForces(const Vector& u, const ForceEvaluation& evaluation) const override;
+  double elasticEnergy(const Vector& u, double stage_position) const override;
+  double externalWork(const Vector& u_from, const Vector& u_to) const override;
+  SparseMatrix stiffnessMatrix() const override;
+  /// The foundation's k_f on the node's u_z.
+  void releaseContact(SparseMatrix& stiffness, int node) const override;
+  SparseMatrix dampingMatrix() const override;
+  bool rebalanceLoad(const Vector& u) override;
+  /// Every bottom node's x (InterfaceLoading::Stuck), or only the middle one's, which takes out the
+  /// free slider's rigid translation and carries no force (InterfaceLoading::Free).
+  std::vector<int> blockedDofsDuringLoading() const override;
+  void disconnectPusher() override { pusher_connected_ = false; }
+  void connectPusher(const Vector& u) override;
+  double pushingHeight() const override;
+  void setNormalLoad(double normal_force) override { normal_force_ = normal_force; }
+  /// Not with the spring mattress: its plate is placed once, when F_Z is applied. Moving it by
+  /// ΔF_Z/(N_x·k_m) would not do: the slider yields under it, and the springs end up carrying a fraction
+  /// of the change (in a 29 × 16 slider, 49 N of 580 N asked).
+  bool takesNormalLoadChanges() const override { return !mattress_; }
+  GaugeStresses gaugeStresses(const Vector& u, double height,
+                              const std::vector<double>& positions) const override;
+  void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const override;
+  std::vector<double> nodeSpeeds(const Vector& v) const override;
+  GaugeStresses nodeStresses(const Vector& u) const override;
+  std::array<int, 2> gridShape() const override { return {nx_, nz_}; }
+  double nodeSpacing() const override { return spacing_; }
+
+  /// Pa, cell-average (virial) stress of cell (i, j) spanning nodes i..i+1, j..j+1, from the spring
+  /// forces: σ = (1/(l²B)) Σ w·T·r̂⊗r, edges weighted ½ (shared with the neighbour cell), diagonals 1.
+  std::array<double, 3> cellStress(const Vector& u, int i, int j) const;
+
+ private:
+  /// One family of bonds: all springs from node (i, j) to (i + di, j + dj).
+  struct BondFamily {
+    int di, dj;
+    double stiffness;    ///< N/m
+    double rest_length;  ///< m
+    double ex, ez;       ///< rest unit vector
+  };
+
+  template <class Visit>
+  void forEachBond(const BondFamily& family, Visit&& visit) const;
+  double topSpringForce(const Vector& u, int i) const;
+
+  int nx_, nz_, n_;
+  double spacing_, width_, mass_, k_, eta_, kf_;
+  bool geometric_;
+  std::vector<BondFamily> families_;
+  double normal_force_;
+  bool mattress_;
+  bool interface_free_while_loading_;
+  double mattress_k_, mattress_kx_per_node_;
+  double plate_z_ = 0.0;             ///< m, displacement of the mattress plate
+  std::vector<double> top_anchor_x_;  ///< m, where the mattress holds each top node in x
+  std::vector<int> pushed_rows_;
+  double pusher_k_per_row_;
+  std::vector<double> pusher_offset_;  ///< m, u_x of each pushed node when the pusher was connected
+  bool pusher_connected_ = true;
+  /// The bond forces (N, on the bond's lower-index node) from a row up to the next, zero-padded so that
+  /// the node loop needs no edge cases.
+  struct RowBonds {
+    std::vector<double> vertical_x, vertical_z, diagonal_x, diagonal_z, antidiagonal_x, antidiagonal_z;
+    void resize(int size);
+    void clear();
+  };
+  /// Work space of one force sweep: the upward bond forces of the current row and of the row below, and
+  /// the viscous power (W) summed per column. Eigen's storage for the power: Eigen sums aligned packets
+  /// and adds the unaligned ends apart, so in a buffer of std::vector's alignment the total's last bits
+  /// would depend on where the heap put it.
+  struct SweepSpace {
+    RowBonds upward, below;
+    Eigen::ArrayXd column_power;
+  };
+  /// One force evaluation, row by row (lattice_2d.cpp).
+  class Sweep;
+  /// The bond forces along x of the row being swept, padded the same way; shared by the sweeps, which
+  /// take a whole row at a time.
+  mutable std::vector<double> horizontal_x_, horizontal_z_;
+  /// Sweeps that run at once (evaluateSuccessiveInStrips), each a strip or two behind the one before. At
+  /// 10⁶ nodes, interleaved in one process (fastest of 15–25 rounds, 2026-11-24): 2 sweeps 4.91 ns per
+  /// node-step, 3 4.70, 4 4.66, 6 4.88 (strips of 1024 nodes), 8 5.12; 4 cost a 1001 × 61 lattice 4 % more
+  /// than 2 (likely their row buffers, 100 kB a sweep at that width, crowding the L2 cache), 3 the same.
+  static constexpr int kSuccessiveSweeps = 3;
+  /// Each sweep's own work space.
+  mutable std::array<SweepSpace, kSuccessiveSweeps> sweep_space_;
+};
+
+}  // namespace friction

@@ -1,0 +1,173 @@
+// The elastic slider seen by the integrators: degrees of freedom, the forces on them (everything but
+// friction, which the contact interface adds), energies and linearised matrices. Implemented by the
+// 2D lattice and the 1D chain.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <array>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "friction_sim/scene/scene.h"
+
+namespace friction {
+
+using Vector = Eigen::VectorXd;
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// A `size` × `size` sparse matrix summed from the entries `fill(add)` passes to add(row, col, value),
+/// at most `entries_per_column` distinct ones per column. Sums in place in the final storage: a
+/// triplet list of a 10⁶-node lattice would take several times the matrix's memory.
+template <class Fill>
+SparseMatrix assembleSparse(int size, int entries_per_column, Fill&& fill) {
+  SparseMatrix matrix(size, size);
+  matrix.reserve(Eigen::VectorXi::Constant(size, entries_per_column));
+  fill([&matrix](int row, int col, double value) { matrix.coeffRef(row, col) += value; });
+  matrix.makeCompressed();
+  return matrix;
+}
+
+/// What one force evaluation produces; friction is not included.
+struct ForceEvaluation {
+  Vector force;              ///< N, per degree of freedom
+  Vector normal_force;       ///< N, per interface node, ≥ 0 (0 = contact lost)
+  double shear_force = 0.0;  ///< N, F_X, the pusher's load-cell reading
+  double normal_load = 0.0;  ///< N, F_Z, the normal load cell (positive when pressing down)
+  double viscous_power = 0.0;  ///< W, dissipated by the pair damping at the given velocities
+};
+
+/// Lets a caller fuse its own passes over the state into a force evaluation, strip by strip, while the
+/// strip is in cache: at 10⁶ nodes separate passes are bound by memory bandwidth. Each hook gets a range
+/// [first, end) of degrees of freedom; by default they do nothing.
+class StripHooks {
+ public:
+  virtual ~StripHooks() = default;
+  /// Called before the evaluation reads the state of these degrees of freedom or writes their forces:
+  /// the caller may still change them here (the integrator's drift).
+  virtual void prepare(int /*first*/, int /*end*/) {}
+  /// Called once the forces on these degrees of freedom are final, and so are the normal forces of the
+  /// interface nodes among them, and their velocities will not be read again (the closing kick).
+  virtual void finish(int /*first*/, int /*end*/) {}
+};
+
+/// One force evaluation of Model::evaluateSuccessiveInStrips: the arguments of evaluateInStrips.
+struct StripEvaluation {
+  const Vector& u;         ///< m, displacements
+  const Vector& v;         ///< m/s, velocities
+  double stage_position;   ///< m
+  Vector& force;           ///< N, per degree of freedom (resized)
+  ForceEvaluation& out;    ///< the rest of the evaluation (its own `force` left alone)
+  StripHooks& hooks;
+};
+
+/// Stress tensor components at the gauge height, at the gauge positions (tension positive).
+struct GaugeStresses {
+  std::vector<double> sigma_xx;  ///< Pa
+  std::vector<double> sigma_zz;  ///< Pa
+  std::vector<double> tau_xz;    ///< Pa
+};
+
+class Model {
+ public:
+  virtual ~Model() = default;
+
+  virtual int dofCount() const = 0;
+  virtual double nodeMass() const = 0;  ///< kg, the same for every node or block
+  virtual int interfaceNodeCount() const = 0;
+  /// Index of the tangential (x) degree of freedom of interface node `node`.
+  virtual int interfaceDof(int node) const = 0;
+  /// m, rest x position of interface node `node`.
+  virtual double interfacePosition(int node) const = 0;
+  /// m, rest x position of every interface node.
+  std::vector<double> interfacePositions() const;
+  /// m², the interface area one node stands for (l·B or a·B), for σ = N/area and τ = f/area.
+  virtual double interfaceNodeArea() const = 0;
+
+  /// Forces at displacements u and velocities v with the stage at `stage_position` (m), written to
+  /// `force` (N, per degree of freedom; resized), the rest of the evaluation to `out` (whose own `force`
+  /// is left alone). The integrators' hot loop passes its acceleration vector as `force`.
+  virtual void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                            ForceEvaluation& out) const = 0;
+  /// evaluateInto() with `hooks` called on strips of about `strip_nodes` nodes; every degree of freedom is
+  /// prepared once and finished once. By default one strip: everything prepared, evaluated, finished.
+  virtual void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
+                                ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const;
+  /// Force evaluations of successive steps. `next(k)` gives evaluation k: first for k = 0, then for k ≥ 1
+  /// once evaluation k − 1's interface forces and friction are final (its strips finished); an empty answer
+  /// ends the series, and for k = successiveEvaluations() `next` must give none (it is still called, to
+  /// say that the last interface is final). Evaluation k may read the state only as evaluation k − 1's
+  /// finish hooks leave it; the sums of every evaluation (shear force, viscous power) are final only once
+  /// this returns. `next` may run no force evaluation: the sweeps are under way in the model's work space.
+  /// A model may sweep each evaluation a few strips behind the one before, so that a large state crosses
+  /// the memory bus once for all of them. Returns how many were evaluated. By default one, as
+  /// evaluateInStrips.
+  virtual int evaluateSuccessiveInStrips(int strip_nodes,
+                                         const std::function<std::optional<StripEvaluation>(int)>& next) const;
+  /// The most evaluations evaluateSuccessiveInStrips sweeps the state once for; 1 where sweeping several
+  /// together would gain nothing (the chain's state stays in the cache).
+  virtual int successiveEvaluations() const { return 1; }
+  /// The same, with the forces in `out.force`.
+  void evaluate(const Vector& u, const Vector& v, double stage_position, ForceEvaluation& out) const {
+    evaluateInto(u, v, stage_position, out.force, out);
+  }
+  /// N, every interface node's normal force before contact clamps it at zero: negative while the node
+  /// is off the track. Fast-forward follows it to where a lifted node lands. `evaluation` is that of u.
+  virtual Vector signedNormalForces(const Vector& u, const ForceEvaluation& evaluation) const = 0;
+  /// J, energy stored in the springs (lattice, foundation, pusher, top load springs).
+  virtual double elasticEnergy(const Vector& u, double stage_position) const = 0;
+  /// J, work done by the constant external forces (the uniform top load) between two states.
+  virtual double externalWork(const Vector& u_from, const Vector& u_to) const = 0;
+
+  /// Stiffness matrix linearised about the rest state, including foundation, pusher and top springs.
+  virtual SparseMatrix stiffnessMatrix() const = 0;
+  /// Takes out of `stiffness` (the matrix above) the contact stiffness of interface node `node`, for an
+  /// equilibrium in which that node is off the track.
+  virtual void releaseContact(SparseMatrix& stiffness, int node) const = 0;
+  /// Damping matrix of the pair damping (force = −C·v).
+  virtual SparseMatrix dampingMatrix() const = 0;
+
+  /// Degrees of freedom held fixed while F_Z is applied (the interface's tangential motion).
+  virtual std::vector<int> blockedDofsDuringLoading() const;
+  /// External forces (N, per dof) applied during the static loading solve in addition to the model's
+  /// own loads, such as a prescribed initial friction profile. Empty = none.
+  virtual Vector initialBodyForce() const { return Vector(); }
+  /// Lets a displacement-controlled load (the spring mattress) re-balance itself during the static
+  /// solve; returns true if it changed.
+  virtual bool rebalanceLoad(const Vector& /*u*/) { return false; }
+
+  /// Pusher connection: while disconnected, the pusher carries no force. `connectPusher` attaches it
+  /// unstretched to the current displacements with the stage at position 0.
+  virtual void disconnectPusher() = 0;
+  virtual void connectPusher(const Vector& u) = 0;
+  /// m, rest height above the interface of the pushed nodes: the pushed row's (the lattice's nearest to
+  /// the scene's h), a band's mean row height (near where the resultant acts: its rows' springs stretch
+  /// a little unequally), or h where the model places it as given (the chain's torque term).
+  virtual double pushingHeight() const = 0;
+
+  /// N, sets the normal load F_Z.
+  virtual void setNormalLoad(double normal_force) = 0;
+  /// Whether F_Z may change during a run (setNormalLoad then acts at once).
+  virtual bool takesNormalLoadChanges() const { return true; }
+
+  /// Strain-gauge stresses at height z (m) above the interface at positions x (m).
+  virtual GaugeStresses gaugeStresses(const Vector& u, double height,
+                                      const std::vector<double>& positions) const = 0;
+
+  /// Node positions (rest + displacement) for visualisation: x then z per node.
+  virtual void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const = 0;
+  /// m/s, speed of every node.
+  virtual std::vector<double> nodeSpeeds(const Vector& v) const = 0;
+  /// Stress at every node (mean of the cells around it; zero for the chain, which has no cells).
+  virtual GaugeStresses nodeStresses(const Vector& u) const = 0;
+  /// Nodes along x and along z (the chain: N × 1).
+  virtual std::array<int, 2> gridShape() const = 0;
+  /// m, rest spacing of the nodes (l or a).
+  virtual double nodeSpacing() const = 0;
+};
+
+std::unique_ptr<Model> buildModel(const Scene& scene);
+
+}  // namespace friction

@@ -1,0 +1,209 @@
+// The one run loop of the rig: the offline runner, the simulator node and the tests all drive a scene
+// through a RunDriver, so that they apply commands, step, jump and sample the instruments by the same
+// rule. It owns the Simulation, the command schedule, the stop rule and the sample streams; a caller
+// adds what it does with the samples (files, topics) as streams' sinks, and nothing of its own that
+// steps, jumps or interpolates. No ROS here.
+#pragma once
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "friction_sim/run/command_schedule.h"
+#include "friction_sim/instruments/instruments.h"
+#include "friction_sim/run/simulation.h"
+
+namespace friction {
+
+/// Something that looks at the run after every advance (a step, a group of steps or a fast-forward
+/// jump): an instrument sampled on its own clock of simulated time, or the slip events as they start and
+/// end.
+class RunStream {
+ public:
+  virtual ~RunStream() = default;
+  /// s, the stream's next sample time: no group of steps passes it (inf: the stream has no clock).
+  virtual double nextTime() const { return std::numeric_limits<double>::infinity(); }
+  /// True if a jump also ends at nextTime() where jumps are cut at frames (RunOptions::cut_jumps_at_frames,
+  /// and in a rest with no end).
+  virtual bool cutsJumps() const { return false; }
+  /// Before each advance, after the commands due were applied.
+  virtual void before(const Simulation& /*simulation*/) {}
+  /// After each advance; `jumped` if it was a fast-forward jump.
+  virtual void after(const Simulation& simulation, bool jumped) = 0;
+};
+
+/// How a stream with a clock samples.
+enum class Sampling {
+  /// The reading at the first step end at or after each time on its clock, at that step's time; across a
+  /// jump, interpolated at each time on the clock (the rig's topics).
+  AtSteps,
+  /// Interpolated at each time on its clock, across steps and jumps alike (the offline runner's loading
+  /// curve).
+  Interpolated,
+};
+
+/// A simulated instant, for a stream that carries only its time (the rig's /clock).
+struct Instant {
+  double time = 0.0;  ///< s
+};
+inline Instant interpolate(const Instant& /*a*/, const Instant& /*b*/, double t) { return {t}; }
+
+/// A stream of readings (any type with a `time` in s and an `interpolate(a, b, t)`) sampled at `rate`
+/// (Hz of simulated time), starting one period in: nothing is measured at t = 0.
+template <class Reading>
+class SampledStream : public RunStream {
+ public:
+  using Read = std::function<Reading(const Simulation&)>;
+  using Sink = std::function<void(const Reading&)>;
+  /// `at_event_boundaries`: also at the end of every step where a slip event starts or ends, off the clock.
+  SampledStream(double rate, Sampling sampling, Read read, Sink sink, bool at_event_boundaries = false)
+      : period_(1.0 / rate),
+        next_(1.0 / rate),
+        sampling_(sampling),
+        at_event_boundaries_(at_event_boundaries),
+        read_(std::move(read)),
+        sink_(std::move(sink)) {}
+
+  double nextTime() const override { return next_; }
+  /// True if the last advance produced a sample.
+  bool sampledLast() const { return sampled_last_; }
+
+  void before(const Simulation& simulation) override {
+    // A plain step needs no reading before it where samples are taken at steps.
+    if (sampling_ == Sampling::Interpolated || simulation.mayJump()) before_ = read_(simulation);
+  }
+
+  void after(const Simulation& simulation, bool jumped) override {
+    sampled_last_ = false;
+    if (jumped || sampling_ == Sampling::Interpolated) {
+      const Reading end = read_(simulation);
+      for (; next_ <= simulation.time(); next_ += period_) emit(interpolate(before_, end, next_));
+    }
+    if (sampling_ != Sampling::AtSteps) return;
+    const bool boundary =
+        at_event_boundaries_ && (simulation.eventStartedLastStep() || simulation.eventEndedLastStep());
+    if (dueAt(simulation.time()) || boundary) emit(read_(simulation));
+  }
+
+ private:
+  /// Moves the clock past `now` on its regular grid; true if a sample was due.
+  bool dueAt(double now) {
+    if (now < next_) return false;
+    next_ += period_ * (std::floor((now - next_) / period_) + 1.0);
+    return true;
+  }
+  void emit(const Reading& reading) {
+    sink_(reading);
+    sampled_last_ = true;
+  }
+
+  double period_;  ///< s
+  double next_;    ///< s
+  Sampling sampling_;
+  bool at_event_boundaries_;
+  Read read_;
+  Sink sink_;
+  Reading before_{};
+  bool sampled_last_ = false;
+};
+
+/// The fast camera: a frame at every step where a node unsticks or an event starts or ends, and otherwise
+/// at `rate` during slip events and `idle_rate` while all sticks (Hz of simulated time; each frame's next
+/// counted from it). Across a jump, where all sticks, interpolated at the idle rate. Jumps cut at frames
+/// end at its next one.
+class CameraStream : public RunStream {
+ public:
+  using Sink = std::function<void(const InterfaceFrame&)>;
+  CameraStream(double rate, double idle_rate, Sink sink);
+  double nextTime() const override { return next_; }
+  bool cutsJumps() const override { return true; }
+  void before(const Simulation& simulation) override;
+  void after(const Simulation& simulation, bool jumped) override;
+
+ private:
+  double rate_, idle_rate_;  ///< Hz
+  double next_;              ///< s
+  Sink sink_;
+  InterfaceFrame before_;
+};
+
+/// The slip events as they start (after the step of their onset) and end (`event` is events().back()).
+class EventStream : public RunStream {
+ public:
+  using Started = std::function<void(const Simulation&)>;
+  using Ended = std::function<void(const Simulation&, const SlipEvent& event)>;
+  EventStream(Started started, Ended ended) : started_(std::move(started)), ended_(std::move(ended)) {}
+  void after(const Simulation& simulation, bool jumped) override;
+
+ private:
+  Started started_;
+  Ended ended_;
+};
+
+struct RunOptions {
+  /// s, how long before its time a command is due: 0 for commands at the times they were given, half a
+  /// nanosecond for times recorded rounded to whole nanoseconds (CommandSchedule).
+  double command_early = 0.0;
+  /// End when the scene's stop condition holds; without, only a run end set by setRunEnd ends the run.
+  bool stop_at_scene_end = true;
+  /// Jumps also end at the next time of every stream that cutsJumps() (a paced run: a watcher sees the
+  /// slider move, and a command sent "now" acts within a frame). Its events may then differ from an uncut
+  /// run's by fast-forward's own error: each jump solves the equilibrium afresh.
+  bool cut_jumps_at_frames = false;
+};
+
+/// The stage state now.
+StageStateReading stageState(const Simulation& simulation);
+
+class RunDriver {
+ public:
+  /// For a scene already validated: `stability_limit` (s) is the limit its validation computed.
+  RunDriver(const Scene& scene, double stability_limit, RunOptions options = {});
+
+  Simulation& simulation() { return simulation_; }
+  const Simulation& simulation() const { return simulation_; }
+
+  /// Adds a stream; streams are sampled in the order they were added. Returns it, for its sampledLast().
+  template <class Stream>
+  Stream& add(std::unique_ptr<Stream> stream) {
+    Stream& added = *stream;
+    streams_.push_back(std::move(stream));
+    return added;
+  }
+  /// Called for every command when it comes due: applied (refusal empty) or refused by the simulation.
+  void onCommandDue(CommandSchedule::Report report) { command_due_ = std::move(report); }
+
+  /// Schedules a command at its time (check it first with Simulation::checkCommand): what the simulation
+  /// refuses it for when it is due is reported then.
+  void schedule(const TimedCommand& command) { schedule_.add(command); }
+  /// Replaces the scene's stop condition (Simulation::setStopCondition) and ends the run when it holds,
+  /// whatever stop_at_scene_end. Returns the refusal, or empty.
+  std::string setRunEnd(const StopSpec& stop);
+
+  /// One advance: the commands due by now, then a step, a group of steps or a jump that ends where the
+  /// next command is due (and, cut at frames, at the next frame), then every stream.
+  void advance();
+  /// True once the run's end holds.
+  bool finished() const { return (options_.stop_at_scene_end || run_end_set_) && simulation_.finished(); }
+  /// Advances until finished().
+  void run() {
+    while (!finished()) advance();
+  }
+
+ private:
+  /// s, where the next advance must end at the latest.
+  double jumpEnd() const;
+
+  Simulation simulation_;
+  RunOptions options_;
+  CommandSchedule schedule_;
+  CommandSchedule::Report command_due_ = [](const TimedCommand&, const std::string&) {};
+  std::vector<std::unique_ptr<RunStream>> streams_;
+  bool run_end_set_ = false;
+};
+
+}  // namespace friction

@@ -1,0 +1,62 @@
+// Static equilibrium of the slider with some degrees of freedom held fixed, by modified Newton: the
+// linearised stiffness of the free degrees of freedom is factored once (CHOLMOD's supernodal Cholesky) and
+// corrects the residual of the full (geometric, one-sided) forces until they balance. Used for the
+// loading protocol and, with the interface pinned, for the quasi-static fast-forward. A lattice too
+// large for the factor's memory is solved by multigrid-preconditioned conjugate gradients instead.
+#pragma once
+
+#include <Eigen/CholmodSupport>
+#include <memory>
+#include <vector>
+
+#include "friction_sim/model/model.h"
+
+namespace friction {
+
+class GridMultigrid;
+
+/// How the linearised stiffness is inverted.
+enum class StaticMethod {
+  kAuto,       ///< direct up to kDirectSolveDofs free degrees of freedom, multigrid above
+  kDirect,     ///< CHOLMOD's supernodal Cholesky factor
+  kMultigrid,  ///< conjugate gradients with a geometric multigrid V-cycle (grid models only)
+};
+
+/// Free degrees of freedom up to which kAuto factors: a 2D factor takes about 110 non-zeros per
+/// degree of freedom at 10⁶ nodes (2.2 GB), multigrid about 30 (a few matrix copies).
+constexpr int kDirectSolveDofs = 400000;
+
+class StaticSolver {
+ public:
+  /// Factors the stiffness of every degree of freedom not in `fixed_dofs`, as the model is now
+  /// (pusher connected or not), without the contact stiffness of the interface nodes in `lifted_nodes`.
+  /// With `balance_load`, a displacement-controlled top load (the spring mattress) is re-balanced to carry
+  /// F_Z while solving, as when the load is applied. Throws std::runtime_error if that stiffness is singular.
+  StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load = false,
+               StaticMethod method = StaticMethod::kAuto, const std::vector<int>& lifted_nodes = {});
+  ~StaticSolver();
+
+  /// Modified-Newton iterations after which solve() gives up.
+  static constexpr int kMaxIterations = 500;
+
+  /// Moves the free degrees of freedom of `u` to equilibrium with the stage at `stage_position` (m)
+  /// and the extra forces `body_force` (N per dof; empty = none). The fixed ones stay as they are.
+  /// Returns the number of iterations, kMaxIterations + 1 if it did not converge.
+  int solve(Model& model, Vector& u, double stage_position, const Vector& body_force = Vector()) const;
+
+  /// Displacement of the free degrees of freedom per unit of a force vector on them (K_ff⁻¹·f).
+  Vector response(const Vector& force) const;
+
+  const std::vector<int>& freeDofs() const { return free_dofs_; }
+  /// Conjugate-gradient iterations of the last multigrid solve (0 with the direct method).
+  int multigridIterations() const;
+
+ private:
+  std::vector<int> free_dofs_;
+  std::unique_ptr<Eigen::CholmodSupernodalLLT<SparseMatrix>> factor_;  ///< the direct method's
+  std::unique_ptr<GridMultigrid> multigrid_;                           ///< or the iterative one's
+  double tolerance_;
+  bool balance_load_;
+};
+
+}  // namespace friction

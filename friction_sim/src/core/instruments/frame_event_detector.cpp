@@ -1,0 +1,131 @@
+#include "friction_sim/instruments/frame_event_detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace friction {
+
+namespace {
+bool anySliding(const InterfaceFrame& frame) {
+  return std::any_of(frame.state.begin(), frame.state.end(),
+                     [](std::uint8_t state) { return state == static_cast<std::uint8_t>(ContactState::Sliding); });
+}
+}  // namespace
+
+FrameEventDetector::FrameEventDetector(int front_fit_nodes, double longitudinal_speed, double slider_length)
+    : front_fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed), given_length_(slider_length) {}
+
+void FrameEventDetector::reset() {
+  next_index_ = 0;
+  load_cells_.clear();
+  last_stuck_frame_.reset();
+  in_event_ = false;
+  ended_.clear();
+  last_frame_time_ = -std::numeric_limits<double>::infinity();
+}
+
+void FrameEventDetector::addLoadCells(const LoadCellReading& reading) {
+  load_cells_.push_back(reading);
+}
+
+std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents(bool no_more_readings) {
+  std::vector<SlipEvent> ready;
+  const double latest = no_more_readings     ? std::numeric_limits<double>::infinity()
+                        : load_cells_.empty() ? -std::numeric_limits<double>::infinity()
+                                              : load_cells_.back().time;
+  while (!ended_.empty() && ended_.front().end_time <= latest) {
+    SlipEvent event = std::move(ended_.front());
+    ended_.pop_front();
+    // The last samples taken at or before the onset and the end, and the forces' time averages
+    // (trapezoids) over the samples from the first of those to the second.
+    const LoadCellReading* previous = nullptr;
+    double shear_impulse = 0.0, normal_impulse = 0.0, span = 0.0;
+    // The peak F_X is watched until the whole interface has slipped (SlipEvent::peak_shear_force).
+    // The nodes lifted throughout have no first-unstick time (NaN), which fmax passes over.
+    const double peak_until =
+        event.global ? std::accumulate(event.first_unstick_time.begin(), event.first_unstick_time.end(),
+                                       -std::numeric_limits<double>::infinity(),
+                                       [](double a, double b) { return std::fmax(a, b); })
+                     : event.end_time;
+    for (const LoadCellReading& reading : load_cells_) {
+      if (reading.time <= event.onset_time) {
+        event.onset_shear_force = event.peak_shear_force = reading.shear_force;
+        event.onset_normal_force = reading.normal_force;
+        previous = &reading;
+      } else if (reading.time <= event.end_time && previous) {
+        if (reading.time <= peak_until && std::abs(reading.shear_force) > std::abs(event.peak_shear_force)) {
+          event.peak_shear_force = reading.shear_force;
+        }
+        const double interval = reading.time - previous->time;
+        shear_impulse += 0.5 * (previous->shear_force + reading.shear_force) * interval;
+        normal_impulse += 0.5 * (previous->normal_force + reading.normal_force) * interval;
+        span += interval;
+        previous = &reading;
+      }
+      if (reading.time <= event.end_time) event.end_shear_force = reading.shear_force;
+    }
+    event.mean_shear_force = span > 0.0 ? shear_impulse / span : event.onset_shear_force;
+    event.mean_normal_force = span > 0.0 ? normal_impulse / span : event.onset_normal_force;
+    ready.push_back(std::move(event));
+  }
+  // Keep the samples from the last one before any onset still to be resolved: those of ended and
+  // current events, and of an event starting after the last all-stuck frame.
+  // The topics travel separately: load cells may run ahead of the frames, so never beyond the last frame.
+  double horizon = std::min(latest, last_frame_time_);
+  if (last_stuck_frame_) horizon = std::min(horizon, last_stuck_frame_->time);
+  if (in_event_) horizon = std::min(horizon, current_.onset_time);
+  if (!ended_.empty()) horizon = std::min(horizon, ended_.front().onset_time);
+  while (load_cells_.size() > 1 && load_cells_[1].time <= horizon) load_cells_.pop_front();
+  return ready;
+}
+
+void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
+  const std::size_t n = frame.position.size();
+  last_frame_time_ = frame.time;
+  if (n > 0) frames_length_ = frame.position.back();
+  const bool sliding = anySliding(frame);
+  if (!in_event_) {
+    if (!sliding || !last_stuck_frame_ || last_stuck_frame_->position.size() != n) {
+      if (!sliding) last_stuck_frame_ = frame;
+      return;
+    }
+    in_event_ = true;
+    current_ = SlipEvent{};
+    current_.index = next_index_++;
+    current_.onset_time = frame.time;
+    current_.first_unstick_time.assign(n, std::numeric_limits<double>::quiet_NaN());
+    in_contact_.start(n);
+    double sum = 0.0;
+    int count = 0;
+    for (std::size_t node = 0; node < n; ++node) {
+      if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Sliding)) continue;
+      sum += frame.position[node];
+      ++count;
+    }
+    current_.nucleation_position = sum / count;
+  }
+  for (std::size_t node = 0; node < n; ++node) {
+    if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Detached)) in_contact_.touch(node);
+    if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) &&
+        std::isnan(current_.first_unstick_time[node])) {
+      current_.first_unstick_time[node] = frame.time;
+    }
+  }
+  if (sliding) return;
+
+  in_event_ = false;
+  SlipEvent event = std::move(current_);
+  event.end_time = frame.time;
+  event.node_slip.resize(n);
+  for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = frame.slip[node] - last_stuck_frame_->slip[node];
+  // The slipped nodes are those seen sliding, not merely moved: with an interfacial stiffness stuck
+  // nodes move elastically, and detached nodes move freely.
+  measureExtent(event, frame.position, sliderLength(), in_contact_.count());
+  measureFronts(event, frame.position, front_fit_nodes_, longitudinal_speed_);
+  last_stuck_frame_ = frame;
+  ended_.push_back(std::move(event));
+}
+
+}  // namespace friction

@@ -1,0 +1,124 @@
+#include "friction_sim/instruments/results_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+
+namespace friction {
+
+RunSummary summarize(const Simulation& simulation, double wall_time) {
+  RunSummary summary;
+  const Scene& scene = simulation.scene();
+  summary.scene_name = scene.name;
+  summary.stop_reason = simulation.stopReason();
+  summary.events = static_cast<int>(simulation.events().size());
+  summary.static_friction_macro = std::numeric_limits<double>::quiet_NaN();
+  summary.kinetic_friction_macro = std::numeric_limits<double>::quiet_NaN();
+  for (const SlipEvent& event : simulation.events()) {
+    if (event.global) {
+      summary.static_friction_macro = event.peakShearRatio();
+      summary.kinetic_friction_macro = event.meanShearRatio();
+      break;
+    }
+    if (event.backSlip()) {
+      ++summary.back_slips;
+      continue;
+    }
+    ++summary.precursors;
+    if (event.rupture_length == 0.0) ++summary.single_node_precursors;
+    summary.precursor_points.push_back(
+        {event.onset_shear_force / event.onset_normal_force, event.rupture_length / scene.geometry.length});
+  }
+  summary.simulated_time = simulation.time();
+  summary.steps = simulation.steps();
+  summary.wall_time = wall_time;
+  summary.relative_energy_residual = simulation.energy().relativeResidual();
+  summary.time_step = simulation.timeStep();
+  summary.stability_limit = simulation.stabilityLimit();
+  return summary;
+}
+
+void printSummary(std::ostream& out, const RunSummary& s) {
+  out << "scene " << s.scene_name << ": " << s.stop_reason << "\n"
+      << "  simulated " << s.simulated_time << " s in " << s.steps << " steps of " << s.time_step
+      << " s (stability limit " << s.stability_limit << " s)\n"
+      << "  wall time " << std::setprecision(3) << s.wall_time << " s, "
+      << std::setprecision(4) << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
+      << "  slip events: " << s.events << ", precursors before the first global event: " << s.precursors;
+  if (s.single_node_precursors > 0) out << " (single-node slips, L_p = 0, among them: " << s.single_node_precursors << ")";
+  if (s.back_slips > 0) out << "; back-slips before it, not counted: " << s.back_slips;
+  out << "\n";
+  if (!s.precursor_points.empty()) {
+    out << "  precursors (F_X/F_Z, L_p/L):";
+    for (const PrecursorPoint& point : s.precursor_points) {
+      out << " (" << std::setprecision(4) << point.shear_ratio << ", " << point.length_ratio << ")";
+    }
+    out << "\n";
+  }
+  out << "  mu_s,macro = F_X/F_Z at the first global event: " << s.static_friction_macro << "\n"
+      << "  mu_k,macro = mean F_X / mean F_Z over that event: " << s.kinetic_friction_macro << "\n"
+      << "  energy-balance residual (relative): " << std::setprecision(3) << s.relative_energy_residual
+      << (std::isnan(s.relative_energy_residual) ? " (no energy changed hands: nothing to balance)" : "") << "\n";
+}
+
+void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, const Scene& scene) {
+  out << "index,onset_time_s,end_time_s,onset_shear_force_N,onset_normal_force_N,shear_ratio,"
+         "end_shear_force_N,nucleation_x_m,slip_min_x_m,slip_max_x_m,rupture_length_m,length_ratio,global,"
+         "median_front_speed_m_s,front_speed_over_c_s,front_speed_over_c_r,front_fits_left_out,"
+         "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio,peak_shear_force_N,peak_shear_ratio,mean_slip_m\n";
+  out << std::setprecision(12);
+  const double slider_length = scene.geometry.length;
+  const WaveSpeeds speeds = waveSpeeds(scene);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const SlipEvent& e : events) {
+    out << e.index << ',' << e.onset_time << ',' << e.end_time << ',' << e.onset_shear_force << ','
+        << e.onset_normal_force << ',' << e.onset_shear_force / e.onset_normal_force << ',' << e.end_shear_force
+        << ',' << e.nucleation_position << ',' << e.slip_min_x << ',' << e.slip_max_x << ',' << e.rupture_length
+        << ',' << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << e.median_front_speed
+        << ',' << e.median_front_speed / speeds.shear << ','
+        << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out
+        << ',' << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio() << ','
+        << e.peak_shear_force << ',' << e.peakShearRatio() << ',' << e.meanSlip() << '\n';
+  }
+}
+
+void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,
+                        const std::vector<double>& node_positions) {
+  out << "event,node,x_m,slip_m,first_unstick_time_s,front_speed_m_s\n";
+  out << std::setprecision(12);
+  for (const SlipEvent& e : events) {
+    for (std::size_t node = 0; node < node_positions.size(); ++node) {
+      out << e.index << ',' << node << ',' << node_positions[node] << ',' << e.node_slip[node] << ','
+          << e.first_unstick_time[node] << ',' << e.front_speed[node] << '\n';
+    }
+  }
+}
+
+void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& readings) {
+  out << "time_s,stage_position_m,shear_force_N,normal_force_N,interface_normal_sum_N,sliding_nodes\n";
+  out << std::setprecision(12);
+  for (const LoadCellReading& r : readings) {
+    out << r.time << ',' << r.stage_position << ',' << r.shear_force << ',' << r.normal_force << ','
+        << r.interface_normal_sum << ',' << r.sliding_nodes << '\n';
+  }
+}
+
+void writeStressesHeader(std::ostream& out) {
+  out << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
+         "interface_normal_stress_Pa,interface_shear_stress_Pa\n";
+  out.precision(10);
+}
+
+void writeStressRows(std::ostream& out, int event, const char* phase, const InterfaceFrame& frame,
+                     const GaugeProfile& gauges) {
+  for (std::size_t i = 0; i < frame.position.size(); ++i) {
+    const bool gauge = i < gauges.stress.sigma_zz.size() && gauges.position[i] == frame.position[i];
+    out << event << ',' << phase << ',' << frame.time << ',' << frame.position[i] << ','
+        << (gauge ? gauges.stress.sigma_xx[i] : NAN) << ',' << (gauge ? gauges.stress.sigma_zz[i] : NAN) << ','
+        << (gauge ? gauges.stress.tau_xz[i] : NAN) << ',' << frame.normal_stress[i] << ',' << frame.shear_stress[i]
+        << '\n';
+  }
+}
+
+}  // namespace friction

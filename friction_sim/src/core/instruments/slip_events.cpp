@@ -1,0 +1,250 @@
+#include "friction_sim/instruments/slip_events.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace friction {
+
+double SlipEvent::meanSlip() const {
+  double sum = 0.0;
+  int slipped = 0;
+  for (std::size_t node = 0; node < node_slip.size() && node < first_unstick_time.size(); ++node) {
+    if (std::isnan(first_unstick_time[node])) continue;
+    sum += node_slip[node];
+    ++slipped;
+  }
+  return slipped > 0 ? sum / slipped : std::numeric_limits<double>::quiet_NaN();
+}
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}
+
+SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed,
+                                     double slider_length)
+    : fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed), slider_length_(slider_length) {
+  for (int node = 0; node < model.interfaceNodeCount(); ++node) {
+    positions_.push_back(model.interfacePosition(node));
+    dofs_.push_back(model.interfaceDof(node));
+  }
+  onset_u_.resize(positions_.size());
+}
+
+bool SlipEventDetector::update(double step_start, double dt, const ContactInterface& contact,
+                               const Vector& u, const StepLoads& loads) {
+  const auto& unstuck = contact.unstuckLastStep();
+  auto transition_time = [&](int node) { return step_start + contact.transitionFraction(node) * dt; };
+  auto shear_at = [&](double time) {
+    if (dt <= 0.0) return loads.shear_end;
+    return loads.shear_start + (loads.shear_end - loads.shear_start) * (time - step_start) / dt;
+  };
+  if (!in_event_ && !unstuck.empty()) {
+    in_event_ = true;
+    const std::size_t n = positions_.size();
+    current_ = SlipEvent{};
+    current_.index = static_cast<int>(events_.size());
+    current_.onset_time = step_start + dt;
+    for (int node : unstuck) current_.onset_time = std::min(current_.onset_time, transition_time(node));
+    current_.onset_shear_force = shear_at(current_.onset_time);
+    current_.peak_shear_force = current_.onset_shear_force;
+    slipped_ = 0;
+    in_contact_.start(n);
+    current_.onset_normal_force = loads.normal;
+    shear_impulse_ = 0.0;
+    normal_impulse_ = 0.0;
+    current_.first_unstick_time.assign(n, kNaN);
+    double sum = 0.0;
+    for (int node : unstuck) sum += positions_[node];
+    current_.nucleation_position = sum / unstuck.size();
+    // Slip counts from where the nodes were before this step, including what unsticking caught up.
+    for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
+  }
+  if (!in_event_) return false;
+  in_contact_.note(static_cast<std::size_t>(contact.detachedCount()), [&contact](std::size_t node) {
+    return contact.state(static_cast<int>(node));
+  });
+  const bool was_global = slipped_ == in_contact_.count();
+  double last_first_unstick = step_start;  // of the nodes slipping for the first time in this step
+  for (int node : unstuck) {
+    if (!std::isnan(current_.first_unstick_time[node])) continue;
+    current_.first_unstick_time[node] = transition_time(node);
+    last_first_unstick = std::max(last_first_unstick, current_.first_unstick_time[node]);
+    ++slipped_;
+    in_contact_.touch(static_cast<std::size_t>(node));
+  }
+  const bool ended = contact.slidingCount() == 0;
+  double end_time = step_start + dt;
+  if (ended && !contact.restuckLastStep().empty()) {
+    end_time = step_start;
+    for (int node : contact.restuckLastStep()) end_time = std::max(end_time, transition_time(node));
+  }
+  // The peak is watched until the whole interface has slipped. F_X is linear across the step, so its
+  // value where this step's part of the watch ends bounds it (the start was noted at the onset or by
+  // the step before).
+  if (!was_global) notePeak(shear_at(slipped_ == in_contact_.count() ? last_first_unstick : end_time));
+  // The part of this step inside the event, F_X linear across the step as in shear_at.
+  const double from = std::max(step_start, current_.onset_time);
+  if (end_time > from) {
+    shear_impulse_ += 0.5 * (shear_at(from) + shear_at(end_time)) * (end_time - from);
+    normal_impulse_ += loads.normal * (end_time - from);
+  }
+  if (!ended) return false;
+  finish(end_time, u, shear_at(end_time));
+  return true;
+}
+
+void SlipEventDetector::notePeak(double shear_force) {
+  if (std::abs(shear_force) > std::abs(current_.peak_shear_force)) current_.peak_shear_force = shear_force;
+}
+
+void SlipEventDetector::finish(double end_time, const Vector& u, double end_shear_force) {
+  in_event_ = false;
+  SlipEvent& event = current_;
+  event.end_time = end_time;
+  event.end_shear_force = end_shear_force;
+  const double duration = end_time - event.onset_time;
+  event.mean_shear_force = duration > 0.0 ? shear_impulse_ / duration : event.onset_shear_force;
+  event.mean_normal_force = duration > 0.0 ? normal_impulse_ / duration : event.onset_normal_force;
+  const std::size_t n = positions_.size();
+  event.node_slip.resize(n);
+  for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = u[dofs_[node]] - onset_u_[node];
+  measureExtent(event, positions_, slider_length_, in_contact_.count());
+  measureFronts(event, positions_, fit_nodes_, longitudinal_speed_);
+  if (event.global) ++global_count_;
+  events_.push_back(std::move(event));
+}
+
+FitWindow frontFitWindow(int fit_nodes) {
+  const int nodes = std::max(fit_nodes, 2);
+  return {nodes / 2, (nodes - 1) / 2};
+}
+
+std::vector<double> frontSpeeds(const std::vector<double>& positions,
+                                const std::vector<double>& first_unstick_time, int fit_nodes) {
+  const int n = static_cast<int>(positions.size());
+  std::vector<double> speed(n, kNaN);
+  const auto [behind, ahead] = frontFitWindow(fit_nodes);
+  for (int centre = 0; centre < n; ++centre) {
+    if (std::isnan(first_unstick_time[centre])) continue;
+    // Fit over the slipped nodes of the window around the centre, not across unslipped gaps.
+    int low = centre, high = centre;
+    while (low > 0 && centre - low < behind && !std::isnan(first_unstick_time[low - 1])) --low;
+    while (high + 1 < n && high - centre < ahead && !std::isnan(first_unstick_time[high + 1])) ++high;
+    if (high == low) continue;
+    double mean_x = 0.0, mean_t = 0.0;
+    const int count = high - low + 1;
+    for (int i = low; i <= high; ++i) {
+      mean_x += positions[i] / count;
+      mean_t += first_unstick_time[i] / count;
+    }
+    double sxx = 0.0, sxt = 0.0;
+    for (int i = low; i <= high; ++i) {
+      sxx += (positions[i] - mean_x) * (positions[i] - mean_x);
+      sxt += (positions[i] - mean_x) * (first_unstick_time[i] - mean_t);
+    }
+    const double slowness = std::abs(sxt / sxx);
+    speed[centre] = slowness > 0.0 ? 1.0 / slowness : std::numeric_limits<double>::infinity();
+  }
+  return speed;
+}
+
+namespace {
+/// c_R/c_S for the lattice's ν = 1/3 (MODEL.md §2), the root of the Rayleigh equation.
+constexpr double kRayleighFraction = 0.919;
+}  // namespace
+
+WaveSpeeds waveSpeeds(const Scene& scene) {
+  const double E = scene.material.youngs_modulus, rho = scene.material.density;
+  if (scene.model == ModelKind::Chain1D) {
+    const double bar = std::sqrt(E / rho);
+    return {bar, bar, 0.0};
+  }
+  const double shear = std::sqrt(3.0 * E / 8.0 / rho);
+  return {std::sqrt(3.0) * shear, shear, kRayleighFraction * shear};
+}
+
+FrontSpeedSummary summarizeFrontSpeeds(const std::vector<double>& front_speed,
+                                       const std::vector<double>& first_unstick_time, int fit_nodes,
+                                       double longitudinal_speed) {
+  FrontSpeedSummary summary;
+  const int n = static_cast<int>(front_speed.size());
+  const bool limit_known = longitudinal_speed > 0.0;
+  auto too_fast = [&](int node) {
+    const double speed = front_speed[node];
+    return !std::isnan(speed) && (!std::isfinite(speed) || (limit_known && speed > longitudinal_speed));
+  };
+  // The patches: each run of adjacent nodes that unstuck first (two spots may nucleate at once), grown
+  // through neighbours whose fits are too fast, for those unstuck too nearly together to have a front.
+  double first_time = std::numeric_limits<double>::infinity();
+  for (double time : first_unstick_time) {
+    if (!std::isnan(time)) first_time = std::min(first_time, time);
+  }
+  std::vector<char> in_patch(n, 0);
+  for (int node = 0; node < n; ++node) in_patch[node] = first_unstick_time[node] == first_time;
+  for (int node = 1; node < n; ++node) in_patch[node] |= in_patch[node - 1] && too_fast(node);
+  for (int node = n - 2; node >= 0; --node) in_patch[node] |= in_patch[node + 1] && too_fast(node);
+  // patches_before[i]: patch nodes among nodes [0, i). A fit's window [node − behind, node + ahead]
+  // (frontFitWindow) mixes a patch's times into its slope when it holds a patch node.
+  std::vector<int> patches_before(n + 1, 0);
+  for (int node = 0; node < n; ++node) patches_before[node + 1] = patches_before[node] + in_patch[node];
+  const FitWindow window = frontFitWindow(fit_nodes);
+  auto near_patch = [&](int node) {
+    const int low = std::max(node - window.behind, 0), high = std::min(node + window.ahead, n - 1);
+    return patches_before[high + 1] > patches_before[low];
+  };
+  std::vector<double> running;
+  for (int node = 0; node < n; ++node) {
+    if (std::isnan(front_speed[node])) continue;
+    if (near_patch(node) || too_fast(node)) {
+      ++summary.left_out;
+    } else {
+      running.push_back(front_speed[node]);
+    }
+  }
+  if (running.empty()) {
+    summary.median = kNaN;
+    return summary;
+  }
+  std::sort(running.begin(), running.end());
+  const std::size_t middle = running.size() / 2;
+  summary.median = running.size() % 2 ? running[middle] : 0.5 * (running[middle - 1] + running[middle]);
+  return summary;
+}
+
+void ContactDuringEvent::start(std::size_t nodes) {
+  touched_.assign(nodes, 0);
+  count_ = 0;
+}
+
+void measureExtent(SlipEvent& event, const std::vector<double>& positions, double slider_length,
+                   std::size_t nodes_in_contact) {
+  double x_min = std::numeric_limits<double>::infinity(), x_max = -x_min;
+  std::size_t slipped = 0;
+  for (std::size_t node = 0; node < positions.size(); ++node) {
+    if (std::isnan(event.first_unstick_time[node])) continue;
+    ++slipped;
+    x_min = std::min(x_min, positions[node]);
+    x_max = std::max(x_max, positions[node]);
+  }
+  event.slip_min_x = x_min;
+  event.slip_max_x = x_max;
+  event.global = slipped > 0 && slipped == nodes_in_contact;
+  if (slipped == 0) {
+    event.rupture_length = 0.0;
+  } else if (positions.size() == 1) {
+    event.rupture_length = slider_length;
+  } else {
+    event.rupture_length = x_max - x_min;
+  }
+}
+
+void measureFronts(SlipEvent& event, const std::vector<double>& positions, int fit_nodes, double longitudinal_speed) {
+  event.front_speed = frontSpeeds(positions, event.first_unstick_time, fit_nodes);
+  const FrontSpeedSummary front =
+      summarizeFrontSpeeds(event.front_speed, event.first_unstick_time, fit_nodes, longitudinal_speed);
+  event.median_front_speed = front.median;
+  event.front_fits_left_out = front.left_out;
+}
+
+}  // namespace friction

@@ -1,0 +1,77 @@
+#include "friction_sim/run/run_driver.h"
+
+#include <algorithm>
+
+namespace friction {
+
+CameraStream::CameraStream(double rate, double idle_rate, Sink sink)
+    : rate_(rate), idle_rate_(idle_rate), next_(1.0 / idle_rate), sink_(std::move(sink)) {}
+
+void CameraStream::before(const Simulation& simulation) {
+  if (simulation.mayJump()) before_ = simulation.interfaceFrame();
+}
+
+void CameraStream::after(const Simulation& simulation, bool jumped) {
+  const double t = simulation.time();
+  if (jumped) {
+    const InterfaceFrame end = simulation.interfaceFrame();
+    for (; next_ <= t; next_ += 1.0 / idle_rate_) sink_(interpolate(before_, end, next_));
+  }
+  if (simulation.interfaceChangedLastStep() || t >= next_) {
+    sink_(simulation.interfaceFrame());
+    next_ = t + 1.0 / (simulation.inEvent() ? rate_ : idle_rate_);
+  }
+}
+
+void EventStream::after(const Simulation& simulation, bool /*jumped*/) {
+  if (started_ && simulation.eventStartedLastStep()) started_(simulation);
+  if (ended_ && simulation.eventEndedLastStep()) ended_(simulation, simulation.events().back());
+}
+
+RunDriver::RunDriver(const Scene& scene, double stability_limit, RunOptions options)
+    : simulation_(scene, stability_limit), options_(options), schedule_(options.command_early) {}
+
+std::string RunDriver::setRunEnd(const StopSpec& stop) {
+  std::string refusal = simulation_.setStopCondition(stop);
+  if (refusal.empty()) run_end_set_ = true;
+  return refusal;
+}
+
+double RunDriver::jumpEnd() const {
+  double end = schedule_.nextTime();
+  // A rest with no end (the stage still, nothing due, no program segment to end) is cut at frames too,
+  // or its jump would have no end. Not a rest that ends: cutting a jump changes the run in its last digits.
+  const Stage& stage = simulation_.stage();
+  const bool endless_rest = stage.velocity() == 0.0 && schedule_.empty() && std::isinf(stage.timeToNextChange());
+  if (!options_.cut_jumps_at_frames && !endless_rest) return end;
+  const double command = end;
+  for (const auto& stream : streams_) {
+    // A frame within a step of the command is no cut: the jump would stop a hair short of the command,
+    // and the step after it would pass it.
+    if (stream->cutsJumps() && stream->nextTime() < command - simulation_.timeStep()) {
+      end = std::min(end, stream->nextTime());
+    }
+  }
+  return end;
+}
+
+void RunDriver::advance() {
+  schedule_.applyDue(simulation_, command_due_);
+  const double until = jumpEnd();
+  // Plain steps are taken several at once only where none of them ends at or after a stream's sample
+  // time: every stream sees the steps it samples.
+  double group_before = until;
+  for (const auto& stream : streams_) group_before = std::min(group_before, stream->nextTime());
+  for (const auto& stream : streams_) stream->before(simulation_);
+  const long long jumps = simulation_.jumps();
+  simulation_.advance(until, group_before);
+  const bool jumped = simulation_.jumps() != jumps;
+  for (const auto& stream : streams_) stream->after(simulation_, jumped);
+}
+
+StageStateReading stageState(const Simulation& simulation) {
+  const Stage& stage = simulation.stage();
+  return {simulation.loadCells(), {stage.current().mode, stage.velocity(), stage.current().target, stage.travel()}};
+}
+
+}  // namespace friction

@@ -1,0 +1,313 @@
+#include "friction_sim/scene/loading_protocol.h"
+
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "scene/yaml_fields.h"
+
+namespace friction {
+
+const EnumTable<ProtocolAction>& enumTable(ProtocolAction) {
+  static const EnumTable<ProtocolAction> names{{ProtocolAction::NormalLoad, "normal_load"},
+                                               {ProtocolAction::Hold, "hold"},
+                                               {ProtocolAction::Drive, "drive"},
+                                               {ProtocolAction::MoveTo, "move_to"}};
+  return names;
+}
+
+LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& source) {
+  LoadingProtocol protocol;
+  std::vector<std::string> problems;
+  const YAML::Node root = loadMapping(yaml_text, "protocol", source);
+  YamlFieldReader reader(root, problems);
+  // A step whose action was refused has no rules to check its other keys by: they would blame fields
+  // the user never wrote.
+  std::vector<bool> action_refused;
+  std::set<std::string> missing;  // fields not given: their defaults' values are not refused again below
+  reader.list("steps", protocol.steps, [&](ProtocolStep& step) {
+    const std::string where = "steps[" + std::to_string(action_refused.size()) + "].";
+    auto require = [&](const char* key, const std::string& what) {
+      if (!reader.require(key, what)) missing.insert(where + key);
+    };
+    const std::size_t problems_before = problems.size();
+    reader.field("action", step.action);
+    action_refused.push_back(problems.size() > problems_before);
+    // No default stands in for what a step acts with: a move_to without its target drove the stage
+    // back to 0 and unloaded the slider (found by a new-user walkthrough).
+    if (!action_refused.back()) {
+      if (step.action == ProtocolAction::NormalLoad) require("normal_force", "the F_Z to reach, N");
+      if (step.action == ProtocolAction::Drive || step.action == ProtocolAction::MoveTo) {
+        require("speed", "the stage's speed, m/s");
+      }
+      if (step.action == ProtocolAction::MoveTo) require("target", "the stage position to move to, m");
+    }
+    reader.field("normal_force", step.normal_force);
+    reader.field("ramp_time", step.ramp_time);
+    reader.field("speed", step.speed);
+    reader.field("target", step.target);
+    reader.field("duration", step.duration);
+  });
+  reader.section("end", [&] {
+    reader.field("global_events", protocol.end.global_events);
+    reader.field("stage_travel", protocol.end.stage_travel);
+    reader.field("time", protocol.end.time);
+  });
+  reader.field("ramp_commands", protocol.ramp_commands);
+  reader.rejectUnknownKeys();
+
+  auto problem = [&](const std::string& field, double value, const std::string& allowed) {
+    if (!missing.count(field)) requireSetting(false, field, value, allowed, problems);
+  };
+  for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
+    const ProtocolStep& step = protocol.steps[i];
+    if (i < action_refused.size() && action_refused[i]) continue;
+    const std::string where = "steps[" + std::to_string(i) + "]";
+    if (step.action == ProtocolAction::NormalLoad) {
+      if (!(step.normal_force > 0.0) || !std::isfinite(step.normal_force)) problem(where + ".normal_force", step.normal_force, "a finite F_Z > 0 N");
+      if (!(step.ramp_time >= 0.0) || !std::isfinite(step.ramp_time)) problem(where + ".ramp_time", step.ramp_time, "a finite time >= 0 s");
+    } else {
+      if (!(step.duration > 0.0)) problem(where + ".duration", step.duration, "a duration > 0 s (.inf allowed)");
+      if (!std::isfinite(step.speed)) problem(where + ".speed", step.speed, "a finite speed in m/s");
+      if (step.action == ProtocolAction::MoveTo && !(step.speed > 0.0)) problem(where + ".speed", step.speed, "a travel speed > 0 m/s");
+      if (std::isinf(step.duration) && i + 1 < protocol.steps.size()) {
+        problem(where + ".duration", step.duration, "a finite duration: later steps would never run");
+      }
+    }
+  }
+  if (protocol.end.global_events < 0) problem("end.global_events", protocol.end.global_events, "a count >= 0");
+  if (!(protocol.end.stage_travel > 0.0)) problem("end.stage_travel", protocol.end.stage_travel, "a travel > 0 m");
+  if (!(protocol.end.time > 0.0)) problem("end.time", protocol.end.time, "a time > 0 s");
+  if (protocol.ramp_commands < 1) problem("ramp_commands", protocol.ramp_commands, "an integer >= 1");
+  if (!endsTheRun(StopSpec{protocol.end.global_events, protocol.end.time, protocol.end.stage_travel})) {
+    problems.push_back(std::string("end: ") + kNoEndProblem);
+  }
+  if (!problems.empty()) throw ConfigError("protocol", problems);
+  return protocol;
+}
+
+LoadingProtocol loadProtocol(const std::string& path) {
+  std::vector<std::string> problems;
+  const std::string text = readTextFile(path, problems);
+  if (!problems.empty()) throw ConfigError("protocol", problems);
+  return parseProtocol(text, path);
+}
+
+TimedCommand stepCommand(const ProtocolStep& step) {
+  TimedCommand command;
+  switch (step.action) {
+    case ProtocolAction::NormalLoad:
+      command.kind = TimedCommand::Kind::NormalLoad;
+      command.normal_force = step.normal_force;
+      break;
+    case ProtocolAction::Hold:
+      command.stage = {StageMode::Hold, 0.0, 0.0};
+      break;
+    case ProtocolAction::Drive:
+      command.stage = {StageMode::Velocity, step.speed, 0.0};
+      break;
+    case ProtocolAction::MoveTo:
+      command.stage = {StageMode::Position, step.speed, step.target};
+      break;
+  }
+  return command;
+}
+
+std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, double start_time,
+                                           double start_normal_force) {
+  std::vector<TimedCommand> schedule;
+  double time = start_time;
+  double normal_force = start_normal_force;
+  // The protocol, not the scene's stage program, drives the stage from its start: one that begins by
+  // changing F_Z holds the stage until its first stage step (the scene's program had driven it meanwhile).
+  if (!protocol.steps.empty() && protocol.steps.front().action == ProtocolAction::NormalLoad) {
+    TimedCommand hold;
+    hold.time = start_time;
+    hold.stage = {StageMode::Hold, 0.0, 0.0};
+    schedule.push_back(hold);
+  }
+  for (const ProtocolStep& step : protocol.steps) {
+    if (step.action == ProtocolAction::NormalLoad) {
+      const int commands = step.ramp_time > 0.0 ? protocol.ramp_commands : 1;
+      for (int k = 1; k <= commands; ++k) {
+        TimedCommand command;
+        command.kind = TimedCommand::Kind::NormalLoad;
+        command.time = time + step.ramp_time * (k - 1) / commands;
+        command.normal_force = normal_force + (step.normal_force - normal_force) * k / commands;
+        schedule.push_back(command);
+      }
+      normal_force = step.normal_force;
+      time += step.ramp_time;
+      continue;
+    }
+    TimedCommand command = stepCommand(step);
+    command.time = time;
+    schedule.push_back(command);
+    if (std::isinf(step.duration)) break;
+    time += step.duration;
+  }
+  return schedule;
+}
+
+double stampSeconds(double seconds) {
+  // ros::Time::fromSec, then toSec: the whole seconds, the rest rounded half away from zero to a
+  // nanosecond, carried into the seconds when it rounds up to one.
+  double whole = std::floor(seconds);
+  double nanoseconds = std::round((seconds - whole) * 1e9);
+  if (nanoseconds >= 1e9) {
+    whole += 1.0;
+    nanoseconds -= 1e9;
+  }
+  return whole + 1e-9 * nanoseconds;
+}
+
+namespace {
+
+constexpr const char* kCommandTableHeader = "time_s,command,speed_m_s,target_m,normal_force_N";
+
+/// A number that fills all of `text` (C syntax, inf and nan included).
+bool readNumber(const std::string& text, double& value) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size();
+}
+
+/// A time in seconds. Written with at most nine decimals, as rig_report writes a bag's stamps, it is
+/// read as whole seconds and nanoseconds and summed as ros::Time::toSec() sums them: the rig compared
+/// the command's time with its clock as that double, and a rerun that jumps to the next command must
+/// land on the same one to reproduce the run bit for bit (the nearest double to the decimal text can
+/// differ from it in the last bit).
+bool readStampSeconds(const std::string& text, double& seconds) {
+  const auto point = text.find('.');
+  const std::string whole = text.substr(0, point);
+  const std::string fraction = point == std::string::npos ? "" : text.substr(point + 1);
+  const auto digits = [](const std::string& part) {
+    return part.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (whole.empty() || whole.size() > 9 || fraction.size() > 9 || !digits(whole) || !digits(fraction)) {
+    return readNumber(text, seconds);
+  }
+  const double nanoseconds = fraction.empty() ? 0.0 : std::stod(fraction + std::string(9 - fraction.size(), '0'));
+  seconds = std::stod(whole) + 1e-9 * nanoseconds;
+  return true;
+}
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream stream(line);
+  std::string cell;
+  while (std::getline(stream, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+}  // namespace
+
+std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source,
+                                            const CommandCheck& check) {
+  std::vector<TimedCommand> commands;
+  std::vector<std::string> problems;
+  std::istringstream text(csv_text);
+  std::string line;
+  int line_number = 0;
+  const std::string where_prefix = source.empty() ? "line " : source + ", line ";
+  auto problem = [&](const std::string& what) { problems.push_back(where_prefix + std::to_string(line_number) + ": " + what); };
+  bool header_seen = false;
+  while (std::getline(text, line)) {
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!header_seen) {
+      header_seen = true;
+      if (line != kCommandTableHeader) problem("the header must be '" + std::string(kCommandTableHeader) + "', got '" + line + "'");
+      continue;
+    }
+    if (line.empty()) continue;
+    const std::vector<std::string> cells = splitCsvLine(line);
+    if (cells.size() != 5) {
+      problem("5 fields expected (time_s, command, speed_m_s, target_m, normal_force_N), got " +
+              std::to_string(cells.size()) + " in '" + line + "'");
+      continue;
+    }
+    TimedCommand command;
+    const std::size_t problems_before_row = problems.size();
+    // A row whose time is refused is left out, so that the next is compared with the last good one.
+    const bool time_readable =
+        readStampSeconds(cells[0], command.time) && std::isfinite(command.time) && command.time >= 0.0;
+    if (!time_readable) {
+      problem("time_s '" + cells[0] + "' is not allowed; allowed: a finite time >= 0 s");
+    } else if (!commands.empty() && command.time < commands.back().time) {
+      problem("time_s " + cells[0] + " is earlier than the row before; allowed: rows in time order");
+    }
+    // The fields each command takes, by column (speed, target, normal_force).
+    static const std::array<const char*, 3> kColumns{"speed_m_s", "target_m", "normal_force_N"};
+    std::array<bool, 3> takes{};
+    const std::string& name = cells[1];
+    if (name == "velocity") {
+      command.stage = {StageMode::Velocity, 0.0, 0.0};
+      takes = {true, false, false};
+    } else if (name == "hold") {
+      command.stage = {StageMode::Hold, 0.0, 0.0};
+    } else if (name == "position") {
+      command.stage = {StageMode::Position, 0.0, 0.0};
+      takes = {true, true, false};
+    } else if (name == "normal_load") {
+      command.kind = TimedCommand::Kind::NormalLoad;
+      takes = {false, false, true};
+    } else {
+      problem("command '" + name + "' is unknown; allowed: velocity, hold, position, normal_load");
+      continue;
+    }
+    std::array<double*, 3> fields{&command.stage.speed, &command.stage.target, &command.normal_force};
+    for (std::size_t column = 0; column < kColumns.size(); ++column) {
+      const std::string& cell = cells[column + 2];
+      if (!takes[column]) {
+        if (!cell.empty()) problem(name + " takes no " + kColumns[column] + ", got '" + cell + "'; leave it empty");
+      } else if (!readNumber(cell, *fields[column])) {
+        problem(name + " needs " + kColumns[column] + " as a number, got '" + cell + "'");
+      }
+    }
+    // What the run would refuse, for a row that is well formed: listed with the table's own problems.
+    if (check && problems.size() == problems_before_row) {
+      const std::string refusal = check(command);
+      if (!refusal.empty()) problem(refusal);
+    }
+    if (time_readable) commands.push_back(command);
+  }
+  if (!header_seen) problems.push_back(where_prefix + "1: empty; a command table starts with its header '" +
+                                       std::string(kCommandTableHeader) + "'");
+  if (!problems.empty()) throw ConfigError("command table", problems);
+  return commands;
+}
+
+std::vector<TimedCommand> loadCommandTable(const std::string& path, const CommandCheck& check) {
+  std::vector<std::string> problems;
+  const std::string text = readTextFile(path, problems);
+  if (!problems.empty()) throw ConfigError("command table", problems);
+  return parseCommandTable(text, path, check);
+}
+
+bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time) {
+  return (end.global_events > 0 && global_events >= end.global_events) || stage_travel >= end.stage_travel ||
+         elapsed_time >= end.time;
+}
+
+std::vector<TimedCommand> protocolCommands(const LoadingProtocol& protocol, double start_normal_force) {
+  std::vector<TimedCommand> commands = scheduleProtocol(protocol, 0.0, start_normal_force);
+  for (TimedCommand& command : commands) command.time = stampSeconds(command.time);
+  return commands;
+}
+
+void checkProtocolSteps(const LoadingProtocol& protocol, const std::string& path, const CommandCheck& check) {
+  std::vector<std::string> problems;
+  for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
+    const std::string refusal = check(stepCommand(protocol.steps[i]));
+    if (!refusal.empty()) problems.push_back(path + ", steps[" + std::to_string(i) + "]: " + refusal);
+  }
+  if (!problems.empty()) throw ConfigError("protocol", problems);
+}
+
+}  // namespace friction

@@ -1,0 +1,123 @@
+#include "friction_sim/solvers/static_solver.h"
+
+#include "solvers/grid_multigrid.h"
+
+#include <stdexcept>
+
+namespace friction {
+
+namespace {
+/// Relative residual at which a multigrid solve stops; the modified-Newton loop corrects the rest.
+constexpr double kMultigridTolerance = 1e-10;
+
+/// The stiffness of the free degrees of freedom (`position_in_free` is −1 for a fixed one). The
+/// model's matrix is compacted in place (entries only move towards the front) rather than copied into
+/// a second matrix: a 10⁶-node lattice's stiffness takes 450 MB. Trimming the storage to its new size
+/// still reallocates once. `lower_only` keeps the lower triangle, all the factorisation reads.
+SparseMatrix freeStiffness(const Model& model, const std::vector<int>& lifted_nodes,
+                           const std::vector<int>& position_in_free, int free_count, bool lower_only) {
+  SparseMatrix stiffness = model.stiffnessMatrix();
+  for (int node : lifted_nodes) model.releaseContact(stiffness, node);
+  stiffness.makeCompressed();
+  int* outer = stiffness.outerIndexPtr();
+  int* inner = stiffness.innerIndexPtr();
+  double* value = stiffness.valuePtr();
+  int written = 0;
+  int column_start = outer[0];
+  for (int column = 0; column < stiffness.outerSize(); ++column) {
+    const int column_end = outer[column + 1];
+    const int col = position_in_free[column];
+    if (col >= 0) {
+      outer[col] = written;  // col ≤ column: that start has been read already
+      for (int k = column_start; k < column_end; ++k) {
+        const int row = position_in_free[inner[k]];
+        if (row < (lower_only ? col : 0)) continue;
+        inner[written] = row;
+        value[written++] = value[k];
+      }
+    }
+    column_start = column_end;
+  }
+  outer[free_count] = written;
+  stiffness.data().resize(written);
+  stiffness.conservativeResize(free_count, free_count);
+  stiffness.makeCompressed();
+  if (lower_only) stiffness.data().squeeze();
+  return stiffness;
+}
+
+/// The model's dofs as a grid of nodes (every model is one: the chain's is n × 1).
+GridLayout gridLayoutOf(const Model& model) {
+  const auto shape = model.gridShape();
+  return {shape[0], shape[1], model.dofCount() / (shape[0] * shape[1])};
+}
+}  // namespace
+
+StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dofs, bool balance_load,
+                           StaticMethod method, const std::vector<int>& lifted_nodes)
+    : balance_load_(balance_load) {
+  const int n = model.dofCount();
+  std::vector<char> fixed(n, 0);
+  for (int dof : fixed_dofs) fixed[dof] = 1;
+  std::vector<int> position_in_free(n, -1);
+  for (int dof = 0; dof < n; ++dof) {
+    if (fixed[dof]) continue;
+    position_in_free[dof] = static_cast<int>(free_dofs_.size());
+    free_dofs_.push_back(dof);
+  }
+  tolerance_ = 1e-14 * model.nodeSpacing() * std::max(model.gridShape()[0], 1);
+  if (free_dofs_.empty()) return;
+  const int free_count = static_cast<int>(free_dofs_.size());
+  const GridLayout layout = gridLayoutOf(model);
+  if (method == StaticMethod::kAuto) {
+    // A chain's factor has no fill-in: only a 2D grid gains from multigrid.
+    const bool grid_2d = layout.nodes_x > 2 && layout.nodes_z > 2;
+    method = free_count > kDirectSolveDofs && grid_2d ? StaticMethod::kMultigrid : StaticMethod::kDirect;
+  }
+  if (method == StaticMethod::kMultigrid) {
+    // Not make_unique: it would pass the matrix on by reference, and Eigen 3.4's sparse matrices,
+    // having no move constructor, would be copied (360 MB at 10⁶ nodes).
+    multigrid_.reset(new GridMultigrid(freeStiffness(model, lifted_nodes, position_in_free, free_count, false), free_dofs_, layout));
+    return;
+  }
+  const SparseMatrix reduced = freeStiffness(model, lifted_nodes, position_in_free, free_count, true);
+  factor_ = std::make_unique<Eigen::CholmodSupernodalLLT<SparseMatrix>>(reduced);
+  if (factor_->info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
+}
+
+Vector StaticSolver::response(const Vector& force) const {
+  Vector reduced(free_dofs_.size());
+  for (std::size_t i = 0; i < free_dofs_.size(); ++i) reduced[i] = force[free_dofs_[i]];
+  Vector solution;
+  if (multigrid_) {
+    solution = multigrid_->solve(reduced, kMultigridTolerance);
+  } else if (factor_) {
+    solution = factor_->solve(reduced);
+  } else {
+    solution = reduced;  // no free degree of freedom
+  }
+  Vector out = Vector::Zero(force.size());
+  for (std::size_t i = 0; i < free_dofs_.size(); ++i) out[free_dofs_[i]] = solution[i];
+  return out;
+}
+
+int StaticSolver::solve(Model& model, Vector& u, double stage_position, const Vector& body_force) const {
+  if (free_dofs_.empty()) return 0;
+  ForceEvaluation evaluation;
+  const Vector at_rest = Vector::Zero(u.size());
+  for (int iteration = 1; iteration <= kMaxIterations; ++iteration) {
+    model.evaluate(u, at_rest, stage_position, evaluation);
+    if (body_force.size() > 0) evaluation.force += body_force;
+    const Vector correction = response(evaluation.force);
+    u += correction;
+    const bool load_changed = balance_load_ && model.rebalanceLoad(u);
+    if (!load_changed && correction.lpNorm<Eigen::Infinity>() < tolerance_) return iteration;
+  }
+  return kMaxIterations + 1;
+}
+
+StaticSolver::~StaticSolver() = default;
+
+int StaticSolver::multigridIterations() const { return multigrid_ ? multigrid_->lastIterations() : 0; }
+
+}  // namespace friction
