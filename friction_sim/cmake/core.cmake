@@ -12,14 +12,18 @@ add_library(friction_sim_core
   src/core/contact/friction_law.cpp
   src/core/instruments/frame_event_detector.cpp
   src/core/instruments/instruments.cpp
+  src/core/instruments/readouts.cpp
   src/core/instruments/results_io.cpp
   src/core/instruments/slip_events.cpp
   src/core/model/chain_1d.cpp
   src/core/model/lattice_2d.cpp
   src/core/model/model.cpp
   src/core/run/command_schedule.cpp
+  src/core/run/fast_forward.cpp
   src/core/run/run_driver.cpp
   src/core/run/simulation.cpp
+  src/core/run/simulation_commands.cpp
+  src/core/run/step_group.cpp
   src/core/scene/config_error.cpp
   src/core/scene/loading_protocol.cpp
   src/core/scene/scene_io.cpp

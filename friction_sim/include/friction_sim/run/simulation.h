@@ -19,14 +19,19 @@
 #include "friction_sim/scene/scene.h"
 #include "friction_sim/instruments/slip_events.h"
 #include "friction_sim/stage/stage.h"
-#include "friction_sim/solvers/static_solver.h"
+#include "friction_sim/run/energy_ledger.h"
 
 namespace friction {
+
+class FastForward;
 
 class Simulation : public Dynamics {
  public:
   /// Throws SceneError if the scene is invalid.
   explicit Simulation(const Scene& scene);
+  ~Simulation() override;
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
   /// For a scene already validated: `stability_limit` (s) is the limit its validation computed.
   Simulation(const Scene& scene, double stability_limit);
 
@@ -46,12 +51,12 @@ class Simulation : public Dynamics {
   /// Advances until the scene's stop condition holds.
   void run();
   /// True while the slider sits in static equilibrium with no node sliding (fast-forward can jump).
-  bool quasiStatic() const { return quasi_static_; }
+  bool quasiStatic() const;
   /// True if the next `advance` may be a fast-forward jump.
-  bool mayJump() const { return quasi_static_ && !approachingThreshold() && !stageTooFast(); }
+  bool mayJump() const;
   /// Fast-forward jumps taken, and simulated time (s) they covered.
-  long long jumps() const { return jumps_; }
-  double jumpedTime() const { return jumped_time_; }
+  long long jumps() const;
+  double jumpedTime() const;
   /// True once the stop condition holds; `stopReason()` says which.
   bool finished() const { return !stop_reason_.empty(); }
   const std::string& stopReason() const { return stop_reason_; }
@@ -119,12 +124,8 @@ class Simulation : public Dynamics {
   double accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) override;
 
  private:
+  friend class FastForward;
   void relaxToLoadedEquilibrium();
-  /// With the interface pinned where it sticks and free where it has lost contact: the static
-  /// equilibrium, if it holds every stuck node within its threshold and in contact and every lifted node
-  /// off the track. Applies it (the energy of the ring-down it skips is counted as viscous dissipation)
-  /// and returns true; otherwise leaves the state as it is.
-  bool relaxToStaticEquilibrium();
   /// What a step keeps from its start for its end.
   struct StepStart {
     long long contact_changes;  ///< the contact's lift-offs and landings so far
@@ -153,20 +154,6 @@ class Simulation : public Dynamics {
   static constexpr int kMaxGroupSteps = 3;
   /// Step k's force evaluation in stepInGroup.
   ForceEvaluation& groupEvaluation(int k) { return k == 0 ? evaluation_ : later_evaluations_[k - 1]; }
-  /// The jumps of `advance`; returns false if a dynamic step is needed instead.
-  bool fastForward(double until);
-  /// One jump along the pinned equilibrium towards `until` or, if sooner, the next node's threshold
-  /// (then `toward_threshold`, and the jump covers kApproachShare of the way). Returns false, jumping
-  /// nowhere, if less than a step is left.
-  bool jumpAlongEquilibrium(double until, bool& toward_threshold);
-  /// Share of the way to an estimated threshold crossing that one jump covers.
-  static constexpr double kApproachShare = 0.9;
-  /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about five).
-  static constexpr int kMaxApproachJumps = 50;
-  /// The static solver with the interface nodes in contact pinned, those off the track free, the pusher
-  /// on, set up again (factor or multigrid) only when the set of nodes off the track has changed. Null
-  /// if that set leaves the slider free to move (every node lifted, say): then the dynamics go on.
-  StaticSolver* pinnedSolver();
   /// True while the stage moves too fast for the slider to follow it through static equilibria.
   bool stageTooFast() const { return std::abs(stage_.velocity()) > quasi_static_stage_speed_; }
   void refreshAfterStaticChange();
@@ -201,27 +188,11 @@ class Simulation : public Dynamics {
   bool event_ended_ = false;
   bool event_started_ = false;
   std::string stop_reason_;
-  // Energy bookkeeping.
-  double initial_elastic_ = 0.0;
-  double pusher_work_ = 0.0;
-  double external_work_closed_ = 0.0;  ///< J, top-load work before the last change of F_Z
-  Vector external_reference_u_;         ///< displacements at the last change of F_Z
-  double viscous_dissipation_ = 0.0;
-  // Fast-forward.
-  std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
-  std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
-  bool quasi_static_ = false;
-  bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
-  double approach_velocity_ = 0.0;      ///< m/s, the stage's velocity then: the crossing is that motion's
-  /// The dynamics takes a threshold's approach over while the stage keeps the velocity that brings the
-  /// crossing; another motion (a hold, a reversal: a command or a segment of the program) may never
-  /// bring it, and jumps again.
-  bool approachingThreshold() const { return approaching_threshold_ && stage_.velocity() == approach_velocity_; }
+  EnergyLedger ledger_;
   /// m/s, 10⁻³ of the bar-wave speed √(E/ρ): MODEL.md §5's fast-forward rests on a stage far slower than
   /// the waves (the lab's is 10⁻⁸ of it). A stage step that moves faster leaves the static path.
   double quasi_static_stage_speed_;
-  long long jumps_ = 0;
-  double jumped_time_ = 0.0;
+  std::unique_ptr<FastForward> fast_forward_;
 };
 
 }  // namespace friction

@@ -1,0 +1,219 @@
+#include "run/fast_forward.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "friction_sim/run/simulation.h"
+
+namespace friction {
+
+FastForward::FastForward(Simulation& simulation) : sim_(simulation) {}
+
+bool FastForward::approachingThreshold() const {
+  return approaching_threshold_ && sim_.stage_.velocity() == approach_velocity_;
+}
+
+bool FastForward::mayJump() const { return quasi_static_ && !approachingThreshold() && !sim_.stageTooFast(); }
+
+StaticSolver* FastForward::pinnedSolver() {
+  const ContactInterface& contact = sim_.contact_;
+  std::vector<int> lifted;
+  for (int node = 0; node < contact.size(); ++node) {
+    if (contact.state(node) == ContactState::Detached) lifted.push_back(node);
+  }
+  if (lifted != lifted_nodes_ || (lifted_nodes_.empty() && !pinned_solver_)) {
+    pinned_solver_.reset();  // first: at 10⁶ nodes two solvers would not fit the memory budget
+    lifted_nodes_.swap(lifted);
+    std::vector<int> in_contact;
+    for (int node = 0; node < contact.size(); ++node) {
+      if (contact.state(node) != ContactState::Detached) in_contact.push_back(contact.dofs()[node]);
+    }
+    try {
+      pinned_solver_ =
+          std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
+    } catch (const std::runtime_error&) {
+      // Singular: too few nodes in contact hold the slider.
+    }
+  }
+  return pinned_solver_.get();
+}
+
+bool FastForward::relaxToStaticEquilibrium() {
+  Simulation& s = sim_;
+  if (s.contact_.slidingCount() > 0) return false;
+  StaticSolver* solver = pinnedSolver();
+  if (!solver) return false;
+  Vector relaxed = s.u_;
+  // A lifted node that wants its contact back leaves modified Newton without a converged answer.
+  if (solver->solve(*s.model_, relaxed, s.stage_.position()) > StaticSolver::kMaxIterations) return false;
+  ForceEvaluation check;
+  s.model_->evaluate(relaxed, Vector::Zero(s.u_.size()), s.stage_.position(), check);
+  if (!s.contact_.holdsPinned(check)) return false;
+  // What the ring-down would have dissipated: the drop in potential energy plus the kinetic energy.
+  const double stage = s.stage_.position();
+  s.ledger_.addViscous(s.ledger_.potential(*s.model_, s.u_, stage) + s.kineticEnergy() -
+                       s.ledger_.potential(*s.model_, relaxed, stage));
+  s.u_ = relaxed;
+  s.v_.setZero();
+  s.refreshAfterStaticChange();
+  approaching_threshold_ = false;
+  return true;
+}
+
+bool FastForward::jump(double until) {
+  // A jump aimed at a threshold uses the equilibrium's slope where it starts; the slope changes along
+  // the way (the springs' geometry), so a long jump would land off the crossing by a part in 10⁴ of
+  // the load. Approached instead in jumps that each cover a fixed share of what is left, from a slope
+  // taken ever closer to the crossing, until less than a step is left: then the dynamics takes the
+  // node over, and the result no longer depends on where the jumps were cut (`until`).
+  bool jumped = false;
+  bool toward_threshold = true;
+  for (int jump = 1; toward_threshold && jumpAlongEquilibrium(until, toward_threshold); ++jump) {
+    jumped = true;
+    if (sim_.event_started_ || sim_.finished()) break;
+    // A crossing that keeps receding (met tangentially) is left to the dynamics.
+    if (jump == kMaxApproachJumps) {
+      approaching_threshold_ = toward_threshold;
+      approach_velocity_ = sim_.stage_.velocity();
+      break;
+    }
+  }
+  return jumped;
+}
+
+bool FastForward::jumpAlongEquilibrium(double until, bool& toward_threshold) {
+  const Simulation& s = sim_;
+  const StopSpec& stop = s.scene_.stop;
+  const double horizon = std::min({until, stop.time}) - s.time_;
+  const double speed = s.stage_.velocity();
+  // The stage's speed holds until its next change, so a travel limit falls at a known time: the jump
+  // stops there, as full dynamics stops on the step that reaches it.
+  const double to_travel_limit = speed != 0.0 ? (stop.stage_travel - s.stage_.travel()) / std::abs(speed)
+                                              : std::numeric_limits<double>::infinity();
+  const double span = std::min({horizon, s.stage_.timeToNextChange(), to_travel_limit});
+  toward_threshold = false;
+  StaticSolver* solver = pinnedSolver();
+  if (!(span > s.dt_) || !solver) return false;
+  Path path = pathAhead(*solver, span);
+  if (!(path.length > s.dt_)) {
+    approaching_threshold_ = path.stops_at_threshold;
+    approach_velocity_ = speed;
+    return false;
+  }
+  // With nothing due, no end and no threshold ahead (a stage at rest) the jump has no end: nothing
+  // would change along it, and a jump to t = inf would leave NaN behind; the caller steps or bounds it.
+  if (!std::isfinite(path.length)) return false;
+  if (path.stops_at_threshold) path.length *= kApproachShare;
+  toward_threshold = path.stops_at_threshold;
+  // A jump to the caller's time ends on it exactly: time + (until − time) can fall an ulp short, and a
+  // command due then would wait a step (the rig compares due times with the clock exactly).
+  const double end_time =
+      !path.stops_at_threshold && path.length == horizon ? std::min(until, stop.time) : s.time_ + path.length;
+  takeJump(*solver, path, end_time);
+  return true;
+}
+
+FastForward::Path FastForward::pathAhead(StaticSolver& solver, double span) {
+  const Simulation& s = sim_;
+  const Model& model = *s.model_;
+  Path path;
+  path.length = span;
+  path.along = Vector::Zero(s.u_.size());
+  path.velocity = Vector::Zero(s.u_.size());
+  const double speed = s.stage_.velocity();
+  if (speed == 0.0) return path;
+  // The pusher's force per unit stage travel, and the free nodes' response to it.
+  ForceEvaluation here, moved;
+  const Vector at_rest = Vector::Zero(s.u_.size());
+  model.evaluate(s.u_, at_rest, s.stage_.position(), here);
+  model.evaluate(s.u_, at_rest, s.stage_.position() + 1.0, moved);
+  path.along = solver.response(moved.force - here.force);
+  // Friction needed and normal force of every stuck node are affine in the stage position. Along the
+  // path every free node moves at speed·along, and the pair damping's force on the stuck nodes
+  // counts towards their thresholds, as it does once the dynamics takes over.
+  path.velocity = speed * path.along;
+  const double probe = 1e-6 * model.nodeSpacing();
+  model.evaluate(s.u_, path.velocity, s.stage_.position(), here);
+  const Vector probed = s.u_ + probe * path.along;
+  model.evaluate(probed, path.velocity, s.stage_.position() + probe, moved);
+  findFirstCrossing(path, here, moved, probed, probe);
+  return path;
+}
+
+void FastForward::findFirstCrossing(Path& path, const ForceEvaluation& here, const ForceEvaluation& moved,
+                                    const Vector& probed, double probe) {
+  const Simulation& s = sim_;
+  const ContactInterface& contact = s.contact_;
+  const double speed = s.stage_.velocity();
+  auto stop_at = [&path](double time) {
+    if (time < path.length) {
+      path.length = time;
+      path.stops_at_threshold = true;
+    }
+  };
+  Vector lift, lift_moved;  // signed normal forces of the lifted nodes, which land where they reach 0
+  if (contact.detachedCount() > 0) {
+    lift = s.model_->signedNormalForces(s.u_, here);
+    lift_moved = s.model_->signedNormalForces(probed, moved);
+  }
+  for (int node = 0; node < contact.size(); ++node) {
+    if (contact.state(node) == ContactState::Detached) {
+      const double lift_rate = (lift_moved[node] - lift[node]) / probe * speed;
+      if (lift_rate > 0.0) stop_at(-lift[node] / lift_rate);
+      continue;
+    }
+    const int dof = contact.dofs()[node];
+    const double mu = contact.law().staticCoefficient(node);
+    const double force = here.force[dof], force_rate = (moved.force[dof] - force) / probe * speed;
+    const double normal = here.normal_force[node];
+    const double normal_rate = (moved.normal_force[node] - normal) / probe * speed;
+    // Times t > 0 where ±F(t) = µ_s·N(t) or N(t) = 0.
+    for (double sign : {1.0, -1.0}) {
+      const double slope = sign * force_rate - mu * normal_rate;
+      if (slope > 0.0) stop_at((mu * normal - sign * force) / slope);
+    }
+    if (normal_rate < 0.0) stop_at(-normal / normal_rate);
+  }
+}
+
+void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
+  Simulation& s = sim_;
+  const double jump = path.length;
+  const double shear_start = s.evaluation_.shear_force;
+  const double stage_start = s.stage_.position();
+  const double stage_end = s.stage_.positionAfter(jump);
+  s.u_ += (stage_end - stage_start) * path.along;
+  s.stage_.advance(jump);
+  s.time_ = end_time;
+  const double kinetic_before = s.kineticEnergy();
+  solver.solve(*s.model_, s.u_, stage_end);
+  s.v_.swap(path.velocity);
+  // Along the path every node moves with the stage: the stage supplies that kinetic energy, as in the
+  // dynamics, where it accelerates the slider (otherwise the next relaxation would count it as
+  // dissipated); kinetic energy lost when the stage stops rings down in the dynamics.
+  const double kinetic_change = s.kineticEnergy() - kinetic_before;
+  if (kinetic_change > 0.0) {
+    s.ledger_.addPusherWork(kinetic_change);
+  } else {
+    s.ledger_.addViscous(-kinetic_change);
+  }
+  // The jump is a step of its own for the slip of an event that starts at its end (a lifted node moved).
+  s.contact_.beginStep(s.u_, s.v_);
+  s.refreshAfterStaticChange();
+  // Round-off may land a node just past its threshold: then its slip starts here.
+  const ForceEvaluation& end = s.evaluation_;
+  s.detector_.update(s.time_, 0.0, s.contact_, s.u_, {end.shear_force, end.shear_force, end.normal_load});
+  s.ledger_.addPusherWork(shear_start, end.shear_force, stage_start, stage_end);
+  ++jumps_;
+  // Any approach before this jump is over: the crossing, if it comes, is found again from here.
+  approaching_threshold_ = false;
+  jumped_time_ += jump;
+  s.event_started_ = s.detector_.inEvent();
+  s.event_ended_ = false;
+  if (s.event_started_) leavePath();
+  s.checkStop();
+}
+
+}  // namespace friction

@@ -1,0 +1,83 @@
+// Fast-forward (MODEL.md §5): while the interface sits in static equilibrium with no node sliding and
+// the stage moves slowly, the slider follows its pinned equilibrium, and a run jumps along it to the
+// next change instead of stepping. Works on its Simulation's state.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "friction_sim/model/model.h"
+#include "friction_sim/solvers/static_solver.h"
+
+namespace friction {
+
+class Simulation;
+
+class FastForward {
+ public:
+  explicit FastForward(Simulation& simulation);
+
+  /// True while the slider sits in static equilibrium with no node sliding.
+  bool quasiStatic() const { return quasi_static_; }
+  /// True if the next advance may jump.
+  bool mayJump() const;
+  /// The jumps of one advance towards `until` (s); false if a dynamic step is needed instead.
+  bool jump(double until);
+  /// With the interface pinned where it sticks and free where it has lost contact: the static
+  /// equilibrium, if it holds every stuck node within its threshold and in contact and every lifted node
+  /// off the track. Applies it (the energy of the ring-down it skips is counted as viscous dissipation)
+  /// and returns true; otherwise leaves the state as it is.
+  bool relaxToStaticEquilibrium();
+  /// At the loaded equilibrium, or where a step may have brought the slider back to the static path.
+  void setQuasiStatic(bool quasi_static) { quasi_static_ = quasi_static; }
+  /// An event started or the stage moved too fast: off the static path until it is found again.
+  void leavePath() { quasi_static_ = approaching_threshold_ = false; }
+  /// The static solver with the interface nodes in contact pinned, those off the track free, the pusher
+  /// on, set up again (factor or multigrid) only when the set of nodes off the track has changed. Null
+  /// if that set leaves the slider free to move (every node lifted, say): then the dynamics go on.
+  StaticSolver* pinnedSolver();
+
+  long long jumps() const { return jumps_; }
+  double jumpedTime() const { return jumped_time_; }  ///< s
+
+ private:
+  /// Where a jump along the equilibrium goes and how far.
+  struct Path {
+    Vector along;          ///< du/dX_s along the equilibrium
+    Vector velocity;       ///< m/s, every free node moves with the stage
+    double length = 0.0;   ///< s, to the caller's time, the stage's next change, a stop limit or the first threshold
+    bool stops_at_threshold = false;
+  };
+  /// One jump along the pinned equilibrium towards `until` or, if sooner, the next node's threshold
+  /// (then `toward_threshold`, and the jump covers kApproachShare of the way). Returns false, jumping
+  /// nowhere, if less than a step is left.
+  bool jumpAlongEquilibrium(double until, bool& toward_threshold);
+  /// The path from here with the stage at its speed, and the first threshold crossing, lift-off or
+  /// landing along it.
+  Path pathAhead(StaticSolver& solver, double span);
+  /// Shortens `path` to the first time a node reaches its threshold or loses contact, or a lifted node lands.
+  /// `here` and `moved` are the forces at the start and at `probed`, `probe` (m) of stage travel along it.
+  void findFirstCrossing(Path& path, const ForceEvaluation& here, const ForceEvaluation& moved, const Vector& probed,
+                         double probe);
+  /// Moves the slider and the stage along `path` by its length, the clock to `end_time` (s).
+  void takeJump(StaticSolver& solver, Path& path, double end_time);
+  /// Share of the way to an estimated threshold crossing that one jump covers.
+  static constexpr double kApproachShare = 0.9;
+  /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about five).
+  static constexpr int kMaxApproachJumps = 50;
+  /// The dynamics takes a threshold's approach over while the stage keeps the velocity that brings the
+  /// crossing; another motion (a hold, a reversal: a command or a segment of the program) may never
+  /// bring it, and jumps again.
+  bool approachingThreshold() const;
+
+  Simulation& sim_;
+  std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
+  std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
+  bool quasi_static_ = false;
+  bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
+  double approach_velocity_ = 0.0;      ///< m/s, the stage's velocity then: the crossing is that motion's
+  long long jumps_ = 0;
+  double jumped_time_ = 0.0;  ///< s
+};
+
+}  // namespace friction
