@@ -122,6 +122,19 @@ class ContactInterface {
   void setState(int node, ContactState state);
   void stick(int node, const Vector& u);
   void startSliding(int node, int direction);
+  // The rules of finishStep for a node that slid through the step: its direction or re-sticking, then
+  // the work and slip of its friction.
+  bool finishSlidingNode(int node, Vector& u, Vector& v, double dt);
+  /// Sticks `node` where its velocity crossed zero, at `fraction` of the step.
+  void restick(int node, Vector& u, Vector& v, double fraction, double dt);
+  void countSlipOfStep(int node, const Vector& u);
+  // The rules of updateStates: contact lost, contact regained, a stuck node over its threshold (which
+  // then slides for the rest of the step from its crossing).
+  bool loseContact(int node, const Vector& u);
+  /// True if a stuck node's load exceeds µ_s·`normal` (N).
+  bool overThreshold(int node, double normal) const;
+  void regainContact(int node, const Vector& u, const Vector& v);
+  void unstick(int node, Vector& u, Vector& v, double dt, double node_mass);
   /// The law's coefficients for `node` after its state or slip changed.
   void refreshCoefficients(int node);
   /// `node` slid by `slip` (m): the law learns of it and its coefficients follow.

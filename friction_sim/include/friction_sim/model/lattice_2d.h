@@ -88,6 +88,16 @@ class Lattice2D : public Model {
     double ex, ez;       ///< rest unit vector
   };
 
+  /// The tension rule of a bond of `family` whose vector is now (rx, rz) (m), its far node displaced by
+  /// (dux, duz) (m) relative to its near one: the geometric spring acts along the bond as it is, the
+  /// linearised one along its rest direction. The force sweep writes the rule out inline, where it
+  /// vectorises (bondRow).
+  struct BondTension {
+    double stretch;             ///< m, length − rest length (linearised: along the rest direction)
+    double tension_per_length;  ///< N/m
+  };
+  BondTension bondTension(const BondFamily& family, double rx, double rz, double dux, double duz) const;
+
   template <class Visit>
   void forEachBond(const BondFamily& family, Visit&& visit) const;
   double topSpringForce(const Vector& u, int i) const;

@@ -184,54 +184,67 @@ bool ContactInterface::finishStep(Vector& u, Vector& v, double dt) {
     for (int node = 0; node < size(); ++node) {
       // Re-sticking below changes only this node, so state_ still holds the step's start here.
       if (state_[node] != ContactState::Sliding) continue;
-      const int dof = dofs_[node];
-      const double direction = friction_mode_[node];  // ±1: it slides
-      const double v_start = start_v_[node] * direction;
-      const double v_end = v[dof] * direction;
-      if (just_unstuck_[node]) {
-        // It may not re-stick in this step, but friction must oppose its velocity (f = −µ·N·sgn v): had it
-        // kept its direction while moving the other way, its velocity would never pass through zero in
-        // that direction again, and friction would drive it on.
-        if (v_end < 0.0) {
-          friction_mode_[node] = -direction;
-          changed = true;
-        }
-      } else if (v_start >= 0.0 && v_end <= 0.0) {
-        // Velocity is close to linear in time over one step: stop where it crosses zero.
-        const double fraction = v_start > 0.0 ? v_start / (v_start - v_end) : 0.0;
-        u[dof] = start_u_[node] + 0.5 * start_v_[node] * fraction * dt;
-        v[dof] = 0.0;
-        setState(node, ContactState::Stuck);
-        transition_fraction_[node] = fraction;
-        clearLoad(node);
-        restuck_last_step_.push_back(node);
-        if (k_t_ > 0.0) {
-          // Place the anchor so that the friction force is continuous; that spring energy has to come
-          // from somewhere in the bookkeeping, and friction is where the model puts it.
-          anchor_[node] = u[dof] + start_friction_[node] / k_t_;
-          dissipation_ -= 0.5 * start_friction_[node] * start_friction_[node] / k_t_;
-        } else {
-          anchor_[node] = u[dof];
-        }
-        changed = true;
-      }
-      // The work of the friction the step applied, by the trapezoid as velocity Verlet applies it: its
-      // value at the step's start and at its end, where it slid on. Slip weakening lowers it within the
-      // step, and the start's value alone overstated the dissipation to first order in dt (6e-4 of the
-      // work for a single block at dt = 1 µs, found by a review). One that stopped within the step
-      // had the start's friction up to the stop.
-      const double end_friction =
-          state_[node] == ContactState::Sliding ? friction_[latest_slot_][node] : start_friction_[node];
-      const double slip = u[dof] - start_u_[node];
-      dissipation_ -= 0.5 * (start_friction_[node] + end_friction) * slip;
-      const double sliding_before = sliding_coefficient_[node];
-      addSlip(node, slip);
-      // Fully weakened (or under a law without slip) the coefficient stays: nothing to apply again.
-      slip_changed_coefficients_ = slip_changed_coefficients_ || sliding_coefficient_[node] != sliding_before;
+      changed = finishSlidingNode(node, u, v, dt) || changed;
     }
   }
   for (int node : unstuck_last_step_) just_unstuck_[node] = 0;  // the only nodes flagged
   return changed;
+}
+
+bool ContactInterface::finishSlidingNode(int node, Vector& u, Vector& v, double dt) {
+  bool changed = false;
+  const int dof = dofs_[node];
+  const double direction = friction_mode_[node];  // ±1: it slides
+  const double v_start = start_v_[node] * direction;
+  const double v_end = v[dof] * direction;
+  if (just_unstuck_[node]) {
+    // It may not re-stick in this step, but friction must oppose its velocity (f = −µ·N·sgn v): had it
+    // kept its direction while moving the other way, its velocity would never pass through zero in
+    // that direction again, and friction would drive it on.
+    if (v_end < 0.0) {
+      friction_mode_[node] = -direction;
+      changed = true;
+    }
+  } else if (v_start >= 0.0 && v_end <= 0.0) {
+    // Velocity is close to linear in time over one step: stop where it crosses zero.
+    restick(node, u, v, v_start > 0.0 ? v_start / (v_start - v_end) : 0.0, dt);
+    changed = true;
+  }
+  countSlipOfStep(node, u);
+  return changed;
+}
+
+void ContactInterface::restick(int node, Vector& u, Vector& v, double fraction, double dt) {
+  const int dof = dofs_[node];
+  u[dof] = start_u_[node] + 0.5 * start_v_[node] * fraction * dt;
+  v[dof] = 0.0;
+  setState(node, ContactState::Stuck);
+  transition_fraction_[node] = fraction;
+  clearLoad(node);
+  restuck_last_step_.push_back(node);
+  if (k_t_ > 0.0) {
+    // Place the anchor so that the friction force is continuous; that spring energy has to come
+    // from somewhere in the bookkeeping, and friction is where the model puts it.
+    anchor_[node] = u[dof] + start_friction_[node] / k_t_;
+    dissipation_ -= 0.5 * start_friction_[node] * start_friction_[node] / k_t_;
+  } else {
+    anchor_[node] = u[dof];
+  }
+}
+
+void ContactInterface::countSlipOfStep(int node, const Vector& u) {
+  // The work of the friction the step applied, by the trapezoid as velocity Verlet applies it: its
+  // value at the step's start and at its end, where it slid on (slip weakening lowers it within the
+  // step, to first order in dt). One that stopped within the step had the start's friction up to the
+  // stop.
+  const double end_friction =
+      state_[node] == ContactState::Sliding ? friction_[latest_slot_][node] : start_friction_[node];
+  const double slip = u[dofs_[node]] - start_u_[node];
+  dissipation_ -= 0.5 * (start_friction_[node] + end_friction) * slip;
+  const double sliding_before = sliding_coefficient_[node];
+  addSlip(node, slip);
+  // Fully weakened (or under a law without slip) the coefficient stays: nothing to apply again.
+  slip_changed_coefficients_ = slip_changed_coefficients_ || sliding_coefficient_[node] != sliding_before;
 }
 
 void ContactInterface::stick(int node, const Vector& u) {
@@ -269,7 +282,6 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
   // Also when no step came between updates.
   for (int node : unstuck_last_step_) just_unstuck_[node] = landed_sliding_[node] = 0;
   unstuck_last_step_.clear();
-  const int n = size();
   // The last friction pass recorded every node's load and whether any node needs one of the rules
   // below. Usually none does, and the step ends here.
   if (attention_ == 0) {
@@ -277,62 +289,75 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     return false;
   }
   bool changed = false;
-  const int previous_slot = current_slot_ ^ 1;
-  for (int node = 0; node < n; ++node) {
-    const int dof = dofs_[node];
+  for (int node = 0; node < size(); ++node) {
     const double normal = latest_normal_[node];
     if (normal <= 0.0) {
-      if (state_[node] != ContactState::Detached) {
-        if (state_[node] == ContactState::Stuck) dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
-        setState(node, ContactState::Detached);
-        changed = true;
-      }
-      continue;
-    }
-    if (state_[node] == ContactState::Detached) {
-      // Contact returns as this update sees it, at the step's end; the fraction of its last transition
-      // is stale.
-      transition_fraction_[node] = 1.0;
-      if (v[dof] != 0.0) {
-        startSliding(node, v[dof] > 0.0 ? 1 : -1);
-        landed_sliding_[node] = 1;
-      } else {
-        stick(node, u);
-      }
+      changed = loseContact(node, u) || changed;
+    } else if (state_[node] == ContactState::Detached) {
+      regainContact(node, u, v);
       changed = true;
-      continue;
+    } else if (state_[node] == ContactState::Stuck && overThreshold(node, normal)) {
+      unstick(node, u, v, dt, node_mass);
+      changed = true;
     }
-    const double held = std::abs(friction_[current_slot_][node]);
-    const double threshold = static_coefficient_[node] * normal;
-    if (state_[node] != ContactState::Stuck || held <= threshold) continue;
-    const double ratio = held / threshold;
-    // Its load at the last update. A node stuck since then had contact there; a node that has just stuck
-    // had its load cleared (0), but perhaps no contact there.
-    const double previous_threshold = static_coefficient_[node] * update_normal_[node];
-    const double previous_ratio =
-        previous_threshold > 0.0 ? std::abs(friction_[previous_slot][node]) / previous_threshold : 0.0;
-    transition_fraction_[node] =
-        previous_ratio < 1.0 ? std::clamp((1.0 - previous_ratio) / (ratio - previous_ratio), 0.0, 1.0) : 0.0;
-    // The spring energy of an elastic anchor is released into the slip.
-    dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
-    // It slides opposite to the friction that held it.
-    startSliding(node, friction_[current_slot_][node] > 0.0 ? -1 : 1);
-    const double late = (1.0 - transition_fraction_[node]) * dt;
-    // At the coefficient of the moment it unstuck: weakening within the catch-up itself (a fraction of
-    // one step's slip) is left out, in the motion and in the dissipation alike.
-    const double sliding_friction = -sliding_coefficient_[node] * normal * friction_mode_[node];
-    const double acceleration = (other_force_[node] + sliding_friction) / node_mass;
-    const double catch_up = 0.5 * acceleration * late * late;
-    if (!start_positions_kept_) start_u_[node] = u[dof];
-    u[dof] += catch_up;
-    v[dof] += acceleration * late;
-    dissipation_ -= sliding_friction * catch_up;
-    // Slip weakening counts the catch-up too: it is slip since unsticking that no step will measure.
-    addSlip(node, catch_up);
-    changed = true;
   }
   rotateLoads();
   return changed;
+}
+
+bool ContactInterface::overThreshold(int node, double normal) const {
+  return !(std::abs(friction_[current_slot_][node]) <= static_coefficient_[node] * normal);
+}
+
+bool ContactInterface::loseContact(int node, const Vector& u) {
+  if (state_[node] == ContactState::Detached) return false;
+  if (state_[node] == ContactState::Stuck) dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dofs_[node]], 2);
+  setState(node, ContactState::Detached);
+  return true;
+}
+
+void ContactInterface::regainContact(int node, const Vector& u, const Vector& v) {
+  // Contact returns as this update sees it, at the step's end; the fraction of its last transition is
+  // stale.
+  transition_fraction_[node] = 1.0;
+  const double velocity = v[dofs_[node]];
+  if (velocity != 0.0) {
+    startSliding(node, velocity > 0.0 ? 1 : -1);
+    landed_sliding_[node] = 1;
+  } else {
+    stick(node, u);
+  }
+}
+
+void ContactInterface::unstick(int node, Vector& u, Vector& v, double dt, double node_mass) {
+  const int dof = dofs_[node];
+  const double normal = latest_normal_[node];
+  const double held = std::abs(friction_[current_slot_][node]);
+  const double ratio = held / (static_coefficient_[node] * normal);
+  // Its load at the last update. A node stuck since then had contact there; a node that has just stuck
+  // had its load cleared (0), but perhaps no contact there.
+  const int previous_slot = current_slot_ ^ 1;
+  const double previous_threshold = static_coefficient_[node] * update_normal_[node];
+  const double previous_ratio =
+      previous_threshold > 0.0 ? std::abs(friction_[previous_slot][node]) / previous_threshold : 0.0;
+  transition_fraction_[node] =
+      previous_ratio < 1.0 ? std::clamp((1.0 - previous_ratio) / (ratio - previous_ratio), 0.0, 1.0) : 0.0;
+  // The spring energy of an elastic anchor is released into the slip.
+  dissipation_ += 0.5 * k_t_ * std::pow(anchor_[node] - u[dof], 2);
+  // It slides opposite to the friction that held it.
+  startSliding(node, friction_[current_slot_][node] > 0.0 ? -1 : 1);
+  const double late = (1.0 - transition_fraction_[node]) * dt;
+  // At the coefficient of the moment it unstuck: weakening within the catch-up itself (a fraction of
+  // one step's slip) is left out, in the motion and in the dissipation alike.
+  const double sliding_friction = -sliding_coefficient_[node] * normal * friction_mode_[node];
+  const double acceleration = (other_force_[node] + sliding_friction) / node_mass;
+  const double catch_up = 0.5 * acceleration * late * late;
+  if (!start_positions_kept_) start_u_[node] = u[dof];
+  u[dof] += catch_up;
+  v[dof] += acceleration * late;
+  dissipation_ -= sliding_friction * catch_up;
+  // Slip weakening counts the catch-up too: it is slip since unsticking that no step will measure.
+  addSlip(node, catch_up);
 }
 
 bool ContactInterface::holdsPinned(const ForceEvaluation& trial) const {
