@@ -111,6 +111,48 @@ std::vector<friction::TimedCommand> loadCommands(const Arguments& args, const fr
   return commands;
 }
 
+/// The loading curve into `loading`, and the stresses at each event's onset and end into `stresses_csv`
+/// (its header written), each event printed as it ends.
+void addStreams(friction::RunDriver& driver, std::vector<friction::LoadCellReading>& loading,
+                std::ofstream& stresses_csv) {
+  driver.add(std::make_unique<friction::SampledStream<friction::LoadCellReading>>(
+      driver.simulation().scene().instruments.loading_curve_rate, friction::Sampling::Interpolated,
+      [](const friction::Simulation& s) { return s.loadCells(); },
+      [&loading](const friction::LoadCellReading& reading) { loading.push_back(reading); }));
+  friction::writeStressesHeader(stresses_csv);
+  driver.add(std::make_unique<friction::EventStream>(
+      [&](const friction::Simulation& s) {
+        // The loaded state that gave way: the nodes that unstuck in the onset step at their thresholds.
+        const int event = static_cast<int>(s.events().size());
+        friction::writeStressRows(stresses_csv, event, "onset", s.interfaceFrameBeforeUnsticking(), s.gaugeProfile());
+      },
+      [&](const friction::Simulation& s, const friction::SlipEvent& event) {
+        friction::writeStressRows(stresses_csv, event.index, "end", s.interfaceFrame(), s.gaugeProfile());
+        std::cout << "event " << event.index << " at t = " << event.onset_time
+                  << " s: F_X/F_Z = " << event.onset_shear_force / event.onset_normal_force
+                  << ", L_p/L = " << event.rupture_length / s.scene().geometry.length << (event.global ? " (global)" : "")
+                  << std::endl;
+      }));
+}
+
+/// The result files in `out_dir`, the summary also printed; false if one could not be written in full.
+bool writeResults(const std::string& out_dir, const friction::Simulation& simulation,
+                  const std::vector<friction::LoadCellReading>& loading, double wall, std::ofstream& stresses_csv) {
+  std::ofstream events_csv(out_dir + "/events.csv"), nodes_csv(out_dir + "/event_nodes.csv"),
+      loading_csv(out_dir + "/loading.csv"), scene_yaml(out_dir + "/scene.yaml"), summary_txt(out_dir + "/summary.txt");
+  friction::writeEventsCsv(events_csv, simulation.events(), simulation.scene());
+  friction::writeEventNodesCsv(nodes_csv, simulation.events(), simulation.model().interfacePositions());
+  friction::writeLoadingCsv(loading_csv, loading);
+  scene_yaml << friction::sceneToYaml(simulation.scene());
+  const friction::RunSummary summary = friction::summarize(simulation, wall);
+  friction::printSummary(summary_txt, summary);
+  friction::printSummary(std::cout, summary);
+  for (std::ofstream* file : {&stresses_csv, &events_csv, &nodes_csv, &loading_csv, &scene_yaml, &summary_txt}) {
+    if (!file->flush()) return false;
+  }
+  return true;
+}
+
 int run(int argc, char** argv) {
   Arguments args;
   if (const auto status = parseArguments(argc, argv, args)) return *status;
@@ -143,24 +185,7 @@ int run(int argc, char** argv) {
     if (!refusal.empty()) std::cerr << "warning: command at t = " << command.time << " s refused: " << refusal << "\n";
   });
   std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
-  driver.add(std::make_unique<friction::SampledStream<friction::LoadCellReading>>(
-      scene.instruments.loading_curve_rate, friction::Sampling::Interpolated,
-      [](const friction::Simulation& s) { return s.loadCells(); },
-      [&loading](const friction::LoadCellReading& reading) { loading.push_back(reading); }));
-  friction::writeStressesHeader(stresses_csv);
-  driver.add(std::make_unique<friction::EventStream>(
-      [&](const friction::Simulation& s) {
-        // The loaded state that gave way: the nodes that unstuck in the onset step at their thresholds.
-        const int event = static_cast<int>(s.events().size());
-        friction::writeStressRows(stresses_csv, event, "onset", s.interfaceFrameBeforeUnsticking(), s.gaugeProfile());
-      },
-      [&](const friction::Simulation& s, const friction::SlipEvent& event) {
-        friction::writeStressRows(stresses_csv, event.index, "end", s.interfaceFrame(), s.gaugeProfile());
-        std::cout << "event " << event.index << " at t = " << event.onset_time
-                  << " s: F_X/F_Z = " << event.onset_shear_force / event.onset_normal_force
-                  << ", L_p/L = " << event.rupture_length / scene.geometry.length << (event.global ? " (global)" : "")
-                  << std::endl;
-      }));
+  addStreams(driver, loading, stresses_csv);
   driver.run();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string& commands_source = args.commands_path.empty() ? args.protocol_path : args.commands_path;
@@ -172,17 +197,8 @@ int run(int argc, char** argv) {
     std::cout << "fast-forward: " << simulation.jumps() << " jumps covering " << simulation.jumpedTime() << " s of "
               << simulation.time() << " s\n";
   }
-  std::ofstream events_csv(out_dir + "/events.csv"), nodes_csv(out_dir + "/event_nodes.csv"),
-      loading_csv(out_dir + "/loading.csv"), scene_yaml(out_dir + "/scene.yaml"), summary_txt(out_dir + "/summary.txt");
-  friction::writeEventsCsv(events_csv, simulation.events(), scene);
-  friction::writeEventNodesCsv(nodes_csv, simulation.events(), simulation.model().interfacePositions());
-  friction::writeLoadingCsv(loading_csv, loading);
-  scene_yaml << friction::sceneToYaml(scene);
-  const friction::RunSummary summary = friction::summarize(simulation, wall);
-  friction::printSummary(summary_txt, summary);
-  friction::printSummary(std::cout, summary);
-  for (std::ofstream* file : {&stresses_csv, &events_csv, &nodes_csv, &loading_csv, &scene_yaml, &summary_txt}) {
-    if (!file->flush()) return refuseOutput(out_dir, "a result file could not be written in full");
+  if (!writeResults(out_dir, simulation, loading, wall, stresses_csv)) {
+    return refuseOutput(out_dir, "a result file could not be written in full");
   }
   std::cout << "results written to " << out_dir << "/\n";
   return 0;

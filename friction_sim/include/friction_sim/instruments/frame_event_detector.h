@@ -38,6 +38,8 @@ class FrameEventDetector {
   double sliderLength() const { return given_length_ > 0.0 ? given_length_ : frames_length_; }
 
  private:
+  /// The event's forces from the load cells kept: at its onset and end, its peak, and its means.
+  void addLoadCellsTo(SlipEvent& event) const;
   int front_fit_nodes_;
   double longitudinal_speed_;
   double given_length_;         ///< m, L from the run's scene; 0 unknown

@@ -38,36 +38,7 @@ std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents(bool no_more_read
   while (!ended_.empty() && ended_.front().end_time <= latest) {
     SlipEvent event = std::move(ended_.front());
     ended_.pop_front();
-    // The last samples taken at or before the onset and the end, and the forces' time averages
-    // (trapezoids) over the samples from the first of those to the second.
-    const LoadCellReading* previous = nullptr;
-    double shear_impulse = 0.0, normal_impulse = 0.0, span = 0.0;
-    // The peak F_X is watched until the whole interface has slipped (SlipEvent::peak_shear_force).
-    // The nodes lifted throughout have no first-unstick time (NaN), which fmax passes over.
-    const double peak_until =
-        event.global ? std::accumulate(event.first_unstick_time.begin(), event.first_unstick_time.end(),
-                                       -std::numeric_limits<double>::infinity(),
-                                       [](double a, double b) { return std::fmax(a, b); })
-                     : event.end_time;
-    for (const LoadCellReading& reading : load_cells_) {
-      if (reading.time <= event.onset_time) {
-        event.onset_shear_force = event.peak_shear_force = reading.shear_force;
-        event.onset_normal_force = reading.normal_force;
-        previous = &reading;
-      } else if (reading.time <= event.end_time && previous) {
-        if (reading.time <= peak_until && std::abs(reading.shear_force) > std::abs(event.peak_shear_force)) {
-          event.peak_shear_force = reading.shear_force;
-        }
-        const double interval = reading.time - previous->time;
-        shear_impulse += 0.5 * (previous->shear_force + reading.shear_force) * interval;
-        normal_impulse += 0.5 * (previous->normal_force + reading.normal_force) * interval;
-        span += interval;
-        previous = &reading;
-      }
-      if (reading.time <= event.end_time) event.end_shear_force = reading.shear_force;
-    }
-    event.mean_shear_force = span > 0.0 ? shear_impulse / span : event.onset_shear_force;
-    event.mean_normal_force = span > 0.0 ? normal_impulse / span : event.onset_normal_force;
+    addLoadCellsTo(event);
     ready.push_back(std::move(event));
   }
   // Keep the samples from the last one before any onset still to be resolved: those of ended and
@@ -79,6 +50,39 @@ std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents(bool no_more_read
   if (!ended_.empty()) horizon = std::min(horizon, ended_.front().onset_time);
   while (load_cells_.size() > 1 && load_cells_[1].time <= horizon) load_cells_.pop_front();
   return ready;
+}
+
+void FrameEventDetector::addLoadCellsTo(SlipEvent& event) const {
+  // The last samples taken at or before the onset and the end, and the forces' time averages
+  // (trapezoids) over the samples from the first of those to the second.
+  const LoadCellReading* previous = nullptr;
+  double shear_impulse = 0.0, normal_impulse = 0.0, span = 0.0;
+  // The peak F_X is watched until the whole interface has slipped (SlipEvent::peak_shear_force).
+  // The nodes lifted throughout have no first-unstick time (NaN), which fmax passes over.
+  const double peak_until =
+      event.global ? std::accumulate(event.first_unstick_time.begin(), event.first_unstick_time.end(),
+                                     -std::numeric_limits<double>::infinity(),
+                                     [](double a, double b) { return std::fmax(a, b); })
+                   : event.end_time;
+  for (const LoadCellReading& reading : load_cells_) {
+    if (reading.time <= event.onset_time) {
+      event.onset_shear_force = event.peak_shear_force = reading.shear_force;
+      event.onset_normal_force = reading.normal_force;
+      previous = &reading;
+    } else if (reading.time <= event.end_time && previous) {
+      if (reading.time <= peak_until && std::abs(reading.shear_force) > std::abs(event.peak_shear_force)) {
+        event.peak_shear_force = reading.shear_force;
+      }
+      const double interval = reading.time - previous->time;
+      shear_impulse += 0.5 * (previous->shear_force + reading.shear_force) * interval;
+      normal_impulse += 0.5 * (previous->normal_force + reading.normal_force) * interval;
+      span += interval;
+      previous = &reading;
+    }
+    if (reading.time <= event.end_time) event.end_shear_force = reading.shear_force;
+  }
+  event.mean_shear_force = span > 0.0 ? shear_impulse / span : event.onset_shear_force;
+  event.mean_normal_force = span > 0.0 ? normal_impulse / span : event.onset_normal_force;
 }
 
 void FrameEventDetector::addFrame(const InterfaceFrame& frame) {

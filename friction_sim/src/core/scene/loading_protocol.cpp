@@ -19,26 +19,34 @@ const EnumTable<ProtocolAction>& enumTable(ProtocolAction) {
   return names;
 }
 
-LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& source) {
-  LoadingProtocol protocol;
-  std::vector<std::string> problems;
-  const YAML::Node root = loadMapping(yaml_text, "protocol", source);
-  YamlFieldReader reader(root, problems);
-  // A step whose action was refused has no rules to check its other keys by: they would blame fields
-  // the user never wrote.
+namespace {
+
+/// What reading a protocol's YAML leaves for the checks of its values.
+struct ProtocolReading {
+  /// Per step: its action was refused. Such a step has no rules to check its other keys by: they would
+  /// blame fields the user never wrote.
   std::vector<bool> action_refused;
-  std::set<std::string> missing;  // fields not given: their defaults' values are not refused again below
+  /// Fields not given: their defaults' values are not refused again.
+  std::set<std::string> missing;
+};
+
+/// Reads the protocol's fields into `protocol`, with every unknown key, wrong type and missing field in
+/// `problems`.
+ProtocolReading readProtocolFields(const YAML::Node& root, LoadingProtocol& protocol,
+                                   std::vector<std::string>& problems) {
+  ProtocolReading reading;
+  YamlFieldReader reader(root, problems);
   reader.list("steps", protocol.steps, [&](ProtocolStep& step) {
-    const std::string where = "steps[" + std::to_string(action_refused.size()) + "].";
+    const std::string where = "steps[" + std::to_string(reading.action_refused.size()) + "].";
     auto require = [&](const char* key, const std::string& what) {
-      if (!reader.require(key, what)) missing.insert(where + key);
+      if (!reader.require(key, what)) reading.missing.insert(where + key);
     };
     const std::size_t problems_before = problems.size();
     reader.field("action", step.action);
-    action_refused.push_back(problems.size() > problems_before);
-    // No default stands in for what a step acts with: a move_to without its target drove the stage
-    // back to 0 and unloaded the slider (found by a new-user walkthrough).
-    if (!action_refused.back()) {
+    reading.action_refused.push_back(problems.size() > problems_before);
+    // No default stands in for what a step acts with: a move_to without its target would drive the
+    // stage back to 0 and unload the slider.
+    if (!reading.action_refused.back()) {
       if (step.action == ProtocolAction::NormalLoad) require("normal_force", "the F_Z to reach, N");
       if (step.action == ProtocolAction::Drive || step.action == ProtocolAction::MoveTo) {
         require("speed", "the stage's speed, m/s");
@@ -58,24 +66,29 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
   });
   reader.field("ramp_commands", protocol.ramp_commands);
   reader.rejectUnknownKeys();
+  return reading;
+}
 
+/// Adds to `problems` every value of the protocol out of its range.
+void checkProtocolValues(const LoadingProtocol& protocol, const ProtocolReading& reading,
+                         std::vector<std::string>& problems) {
   auto problem = [&](const std::string& field, double value, const std::string& allowed) {
-    if (!missing.count(field)) requireSetting(false, field, value, allowed, problems);
+    if (!reading.missing.count(field)) requireSetting(false, field, value, allowed, problems);
   };
   for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
     const ProtocolStep& step = protocol.steps[i];
-    if (i < action_refused.size() && action_refused[i]) continue;
+    if (i < reading.action_refused.size() && reading.action_refused[i]) continue;
     const std::string where = "steps[" + std::to_string(i) + "]";
     if (step.action == ProtocolAction::NormalLoad) {
       if (!(step.normal_force > 0.0) || !std::isfinite(step.normal_force)) problem(where + ".normal_force", step.normal_force, "a finite F_Z > 0 N");
       if (!(step.ramp_time >= 0.0) || !std::isfinite(step.ramp_time)) problem(where + ".ramp_time", step.ramp_time, "a finite time >= 0 s");
-    } else {
-      if (!(step.duration > 0.0)) problem(where + ".duration", step.duration, "a duration > 0 s (.inf allowed)");
-      if (!std::isfinite(step.speed)) problem(where + ".speed", step.speed, "a finite speed in m/s");
-      if (step.action == ProtocolAction::MoveTo && !(step.speed > 0.0)) problem(where + ".speed", step.speed, "a travel speed > 0 m/s");
-      if (std::isinf(step.duration) && i + 1 < protocol.steps.size()) {
-        problem(where + ".duration", step.duration, "a finite duration: later steps would never run");
-      }
+      continue;
+    }
+    if (!(step.duration > 0.0)) problem(where + ".duration", step.duration, "a duration > 0 s (.inf allowed)");
+    if (!std::isfinite(step.speed)) problem(where + ".speed", step.speed, "a finite speed in m/s");
+    if (step.action == ProtocolAction::MoveTo && !(step.speed > 0.0)) problem(where + ".speed", step.speed, "a travel speed > 0 m/s");
+    if (std::isinf(step.duration) && i + 1 < protocol.steps.size()) {
+      problem(where + ".duration", step.duration, "a finite duration: later steps would never run");
     }
   }
   if (protocol.end.global_events < 0) problem("end.global_events", protocol.end.global_events, "a count >= 0");
@@ -85,6 +98,15 @@ LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& s
   if (!endsTheRun(StopSpec{protocol.end.global_events, protocol.end.time, protocol.end.stage_travel})) {
     problems.push_back(std::string("end: ") + kNoEndProblem);
   }
+}
+
+}  // namespace
+
+LoadingProtocol parseProtocol(const std::string& yaml_text, const std::string& source) {
+  LoadingProtocol protocol;
+  std::vector<std::string> problems;
+  const ProtocolReading reading = readProtocolFields(loadMapping(yaml_text, "protocol", source), protocol, problems);
+  checkProtocolValues(protocol, reading, problems);
   if (!problems.empty()) throw ConfigError("protocol", problems);
   return protocol;
 }
@@ -205,6 +227,41 @@ std::vector<std::string> splitCsvLine(const std::string& line) {
   return cells;
 }
 
+/// Reads a command table row's command and the fields it takes (cells 1 to 4) into `command`, reporting
+/// each problem; false if the command is unknown.
+bool readCommandFields(const std::vector<std::string>& cells, TimedCommand& command,
+                       const std::function<void(const std::string&)>& problem) {
+  // The fields each command takes, by column (speed, target, normal_force).
+  static const std::array<const char*, 3> kColumns{"speed_m_s", "target_m", "normal_force_N"};
+  std::array<bool, 3> takes{};
+  const std::string& name = cells[1];
+  if (name == "velocity") {
+    command.stage = {StageMode::Velocity, 0.0, 0.0};
+    takes = {true, false, false};
+  } else if (name == "hold") {
+    command.stage = {StageMode::Hold, 0.0, 0.0};
+  } else if (name == "position") {
+    command.stage = {StageMode::Position, 0.0, 0.0};
+    takes = {true, true, false};
+  } else if (name == "normal_load") {
+    command.kind = TimedCommand::Kind::NormalLoad;
+    takes = {false, false, true};
+  } else {
+    problem("command '" + name + "' is unknown; allowed: velocity, hold, position, normal_load");
+    return false;
+  }
+  std::array<double*, 3> fields{&command.stage.speed, &command.stage.target, &command.normal_force};
+  for (std::size_t column = 0; column < kColumns.size(); ++column) {
+    const std::string& cell = cells[column + 2];
+    if (!takes[column]) {
+      if (!cell.empty()) problem(name + " takes no " + kColumns[column] + ", got '" + cell + "'; leave it empty");
+    } else if (!readNumber(cell, *fields[column])) {
+      problem(name + " needs " + kColumns[column] + " as a number, got '" + cell + "'");
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source,
@@ -242,34 +299,7 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
     } else if (!commands.empty() && command.time < commands.back().time) {
       problem("time_s " + cells[0] + " is earlier than the row before; allowed: rows in time order");
     }
-    // The fields each command takes, by column (speed, target, normal_force).
-    static const std::array<const char*, 3> kColumns{"speed_m_s", "target_m", "normal_force_N"};
-    std::array<bool, 3> takes{};
-    const std::string& name = cells[1];
-    if (name == "velocity") {
-      command.stage = {StageMode::Velocity, 0.0, 0.0};
-      takes = {true, false, false};
-    } else if (name == "hold") {
-      command.stage = {StageMode::Hold, 0.0, 0.0};
-    } else if (name == "position") {
-      command.stage = {StageMode::Position, 0.0, 0.0};
-      takes = {true, true, false};
-    } else if (name == "normal_load") {
-      command.kind = TimedCommand::Kind::NormalLoad;
-      takes = {false, false, true};
-    } else {
-      problem("command '" + name + "' is unknown; allowed: velocity, hold, position, normal_load");
-      continue;
-    }
-    std::array<double*, 3> fields{&command.stage.speed, &command.stage.target, &command.normal_force};
-    for (std::size_t column = 0; column < kColumns.size(); ++column) {
-      const std::string& cell = cells[column + 2];
-      if (!takes[column]) {
-        if (!cell.empty()) problem(name + " takes no " + kColumns[column] + ", got '" + cell + "'; leave it empty");
-      } else if (!readNumber(cell, *fields[column])) {
-        problem(name + " needs " + kColumns[column] + " as a number, got '" + cell + "'");
-      }
-    }
+    if (!readCommandFields(cells, command, problem)) continue;
     // What the run would refuse, for a row that is well formed: listed with the table's own problems.
     if (check && problems.size() == problems_before_row) {
       const std::string refusal = check(command);

@@ -61,8 +61,9 @@ std::string formatNumber(double value) {
 
 // The one description of the scene's YAML layout, walked by both the reader and the writer so that
 // the two cannot drift apart.
+// The slider: what it is made of and how it is discretised.
 template <class Visitor>
-void visitScene(Scene& s, Visitor& v) {
+void visitSlider(Scene& s, Visitor& v) {
   v.field("name", s.name);
   v.field("model", s.model);
   v.section("geometry", [&] {
@@ -88,6 +89,11 @@ void visitScene(Scene& s, Visitor& v) {
     v.field("torque_share", s.chain.torque_share);
     v.field("initial_shear", s.chain.initial_shear);
   });
+}
+
+// How the slider is loaded, driven, integrated, measured and stopped.
+template <class Visitor>
+void visitRig(Scene& s, Visitor& v) {
   v.section("friction", [&] {
     v.field("law", s.friction.law);
     v.field("static_coefficient", s.friction.static_coefficient);
@@ -133,6 +139,12 @@ void visitScene(Scene& s, Visitor& v) {
     v.field("time", s.stop.time);
     v.field("stage_travel", s.stop.stage_travel);
   });
+}
+
+template <class Visitor>
+void visitScene(Scene& s, Visitor& v) {
+  visitSlider(s, v);
+  visitRig(s, v);
 }
 
 class YamlWriter {

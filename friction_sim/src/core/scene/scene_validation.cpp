@@ -41,66 +41,62 @@ class Checker {
   std::vector<std::string> problems;
 };
 
-}  // namespace
-
-double largestNormalForce(const Scene& scene) {
-  return 0.05 * scene.material.youngs_modulus * scene.geometry.length * scene.geometry.width;
-}
-
-std::vector<std::string> validateScene(const Scene& s, double* stability_limit) {
-  Checker check;
-  const bool lattice = s.model == ModelKind::Lattice2D;
+void checkBody(Checker& check, const Scene& s) {
   check.positive("geometry.length", s.geometry.length);
   check.positive("geometry.height", s.geometry.height);
   check.positive("geometry.width", s.geometry.width);
   check.positive("material.density", s.material.density);
   check.positive("material.youngs_modulus", s.material.youngs_modulus);
   check.nonNegative("material.damping_coefficient", s.material.damping_coefficient);
+}
 
-  if (lattice) {
-    check.require(s.lattice.nodes_x >= 2, "lattice.nodes_x", s.lattice.nodes_x, "an integer >= 2");
-    check.require(s.lattice.nodes_z >= 2, "lattice.nodes_z", s.lattice.nodes_z, "an integer >= 2");
-    if (s.lattice.nodes_x >= 2 && s.lattice.nodes_z >= 2 && s.geometry.length > 0 && s.geometry.height > 0) {
-      const double spacing_x = s.geometry.length / (s.lattice.nodes_x - 1);
-      const double spacing_z = s.geometry.height / (s.lattice.nodes_z - 1);
-      const bool square = std::abs(spacing_x - spacing_z) <= 1e-6 * spacing_x;
-      std::ostringstream allowed;
-      allowed << "a square lattice: geometry.height/(nodes_z-1) = " << spacing_z
-              << " m must equal geometry.length/(nodes_x-1) = " << spacing_x << " m";
-      // The sizes that fit, so that whichever of the two was changed can be matched.
-      for (int intervals_x = 1; !square && intervals_x <= 10000; ++intervals_x) {
-        const double intervals_z = intervals_x * s.geometry.height / s.geometry.length;
-        if (std::abs(intervals_z - std::round(intervals_z)) > 1e-6 * intervals_z || std::round(intervals_z) < 1) continue;
-        allowed << "; sizes that fit " << s.geometry.length << " m x " << s.geometry.height << " m: nodes_x - 1 a multiple of "
-                << intervals_x << ", e.g. nodes_x: " << 2 * intervals_x + 1
-                << ", nodes_z: " << 2 * std::lround(intervals_z) + 1;
-        break;
-      }
-      check.require(square, "lattice.nodes_z", s.lattice.nodes_z, allowed.str());
+void checkLattice(Checker& check, const Scene& s) {
+  check.require(s.lattice.nodes_x >= 2, "lattice.nodes_x", s.lattice.nodes_x, "an integer >= 2");
+  check.require(s.lattice.nodes_z >= 2, "lattice.nodes_z", s.lattice.nodes_z, "an integer >= 2");
+  if (s.lattice.nodes_x >= 2 && s.lattice.nodes_z >= 2 && s.geometry.length > 0 && s.geometry.height > 0) {
+    const double spacing_x = s.geometry.length / (s.lattice.nodes_x - 1);
+    const double spacing_z = s.geometry.height / (s.lattice.nodes_z - 1);
+    const bool square = std::abs(spacing_x - spacing_z) <= 1e-6 * spacing_x;
+    std::ostringstream allowed;
+    allowed << "a square lattice: geometry.height/(nodes_z-1) = " << spacing_z
+            << " m must equal geometry.length/(nodes_x-1) = " << spacing_x << " m";
+    // The sizes that fit, so that whichever of the two was changed can be matched.
+    for (int intervals_x = 1; !square && intervals_x <= 10000; ++intervals_x) {
+      const double intervals_z = intervals_x * s.geometry.height / s.geometry.length;
+      if (std::abs(intervals_z - std::round(intervals_z)) > 1e-6 * intervals_z || std::round(intervals_z) < 1) continue;
+      allowed << "; sizes that fit " << s.geometry.length << " m x " << s.geometry.height << " m: nodes_x - 1 a multiple of "
+              << intervals_x << ", e.g. nodes_x: " << 2 * intervals_x + 1
+              << ", nodes_z: " << 2 * std::lround(intervals_z) + 1;
+      break;
     }
-    check.positive("lattice.foundation_ratio", s.lattice.foundation_ratio);
-    check.within("instruments.gauge_height", s.instruments.gauge_height, 0.0, s.geometry.height,
-                 "inside the slider, 0..geometry.height");
-  } else {
-    check.require(s.chain.blocks >= 1, "chain.blocks", s.chain.blocks, "an integer >= 1");
-    check.require(std::isfinite(s.chain.tilt), "chain.tilt", s.chain.tilt, "a finite number");
-    check.within("chain.torque_share", s.chain.torque_share, 0.0, 1.0, "share of the moment h*F_X");
-    check.require(s.load.top == TopLoadKind::Uniform, "load.top", static_cast<double>(s.load.top),
-                  "uniform (the chain has no top row)");
-    if (!s.chain.initial_shear.empty()) {
-      check.require(static_cast<int>(s.chain.initial_shear.size()) == s.chain.blocks,
-                    "chain.initial_shear (length)", s.chain.initial_shear.size(),
-                    "one force per block (chain.blocks) or an empty list");
-      for (std::size_t i = 0; i < s.chain.initial_shear.size(); ++i) {
-        check.require(std::isfinite(s.chain.initial_shear[i]), "chain.initial_shear[" + std::to_string(i) + "]",
-                      s.chain.initial_shear[i], "a finite force in N");
-      }
-      // Elastic anchors start unstretched, holding nothing: the prescribed shear would be lost at once.
-      check.require(s.friction.interfacial_stiffness == 0.0, "friction.interfacial_stiffness",
-                    s.friction.interfacial_stiffness, "0 (rigid sticking) with a chain.initial_shear profile");
-    }
+    check.require(square, "lattice.nodes_z", s.lattice.nodes_z, allowed.str());
   }
+  check.positive("lattice.foundation_ratio", s.lattice.foundation_ratio);
+  check.within("instruments.gauge_height", s.instruments.gauge_height, 0.0, s.geometry.height,
+               "inside the slider, 0..geometry.height");
+}
 
+void checkChain(Checker& check, const Scene& s) {
+  check.require(s.chain.blocks >= 1, "chain.blocks", s.chain.blocks, "an integer >= 1");
+  check.require(std::isfinite(s.chain.tilt), "chain.tilt", s.chain.tilt, "a finite number");
+  check.within("chain.torque_share", s.chain.torque_share, 0.0, 1.0, "share of the moment h*F_X");
+  check.require(s.load.top == TopLoadKind::Uniform, "load.top", static_cast<double>(s.load.top),
+                "uniform (the chain has no top row)");
+  if (!s.chain.initial_shear.empty()) {
+    check.require(static_cast<int>(s.chain.initial_shear.size()) == s.chain.blocks,
+                  "chain.initial_shear (length)", s.chain.initial_shear.size(),
+                  "one force per block (chain.blocks) or an empty list");
+    for (std::size_t i = 0; i < s.chain.initial_shear.size(); ++i) {
+      check.require(std::isfinite(s.chain.initial_shear[i]), "chain.initial_shear[" + std::to_string(i) + "]",
+                    s.chain.initial_shear[i], "a finite force in N");
+    }
+    // Elastic anchors start unstretched, holding nothing: the prescribed shear would be lost at once.
+    check.require(s.friction.interfacial_stiffness == 0.0, "friction.interfacial_stiffness",
+                  s.friction.interfacial_stiffness, "0 (rigid sticking) with a chain.initial_shear profile");
+  }
+}
+
+void checkFriction(Checker& check, const Scene& s) {
   const double mu_s = s.friction.static_coefficient, mu_k = s.friction.kinetic_coefficient;
   check.nonNegative("friction.static_coefficient", mu_s);
   // Against a refused µ_s only its own range: "allowed: [0, 0]" would blame a good µ_k.
@@ -111,7 +107,9 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
   }
   check.nonNegative("friction.weakening_length", s.friction.weakening_length);
   check.nonNegative("friction.interfacial_stiffness", s.friction.interfacial_stiffness);
+}
 
+void checkLoad(Checker& check, const Scene& s) {
   check.positive("load.normal_force", s.load.normal_force);
   if (check.clean({"geometry.", "material.youngs_modulus", "load.normal_force"})) {
     std::ostringstream allowed;
@@ -120,7 +118,10 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
   }
   check.nonNegative("load.mattress_stiffness", s.load.mattress_stiffness);
   check.nonNegative("load.mattress_horizontal_stiffness", s.load.mattress_horizontal_stiffness);
+}
 
+void checkPusher(Checker& check, const Scene& s) {
+  const bool lattice = s.model == ModelKind::Lattice2D;
   check.positive("pusher.stiffness", s.pusher.stiffness);
   check.within("pusher.height", s.pusher.height, 0.0, s.geometry.height, "inside the slider, 0..geometry.height");
   if (s.pusher.band_min >= 0.0 || s.pusher.band_max >= 0.0) {
@@ -135,7 +136,9 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
                     "a band [band_min, band_max] that contains at least one lattice row");
     }
   }
+}
 
+void checkStage(Checker& check, const Scene& s) {
   check.positive("stage.max_speed", s.stage.max_speed);
   for (std::size_t i = 0; i < s.stage.program.size(); ++i) {
     const StageSegment& segment = s.stage.program[i];
@@ -153,7 +156,9 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
       check.require(std::isfinite(segment.target), where + ".target", segment.target, "a finite position");
     }
   }
+}
 
+void checkInstrumentsStopAndIntegrator(Checker& check, const Scene& s) {
   check.positive("instruments.loading_curve_rate", s.instruments.loading_curve_rate);
   for (std::size_t i = 0; i < s.instruments.gauge_positions.size(); ++i) {
     check.within("instruments.gauge_positions[" + std::to_string(i) + "]", s.instruments.gauge_positions[i], 0.0,
@@ -171,7 +176,77 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
     check.require(s.friction.interfacial_stiffness == 0.0, "friction.interfacial_stiffness",
                   s.friction.interfacial_stiffness, "0 (rigid sticking) when integrator.fast_forward is true");
   }
+}
 
+/// The chain's statics: every block pressed on the track whichever way the stage pushes, and a prescribed
+/// shear profile within the blocks' static thresholds.
+void checkChainStatics(Checker& check, const Scene& s) {
+  const Chain1D chain(s);
+  // |F_X| stays below the interface's total static friction µ_s·F_Z, in either direction: the stage
+  // program or the controller may drive the stage back. w_i is linear in F_X, so the ends suffice.
+  const double most_shear = s.friction.static_coefficient * s.load.normal_force;
+  bool reported = false;
+  for (double shear : {0.0, most_shear, -most_shear}) {
+    const std::vector<double> w = chain.normalForces(shear);
+    for (std::size_t i = 0; i < w.size() && !reported; ++i) {
+      if (w[i] > 0.0) continue;
+      std::ostringstream text;
+      text << "chain.tilt/chain.torque_share: the normal force of block " << i << " would be " << w[i]
+           << " N at F_X = " << shear << " N; allowed: every block's normal force w_i > 0 for F_X in [" << -most_shear
+           << ", " << most_shear << "] N, the stage pushing or pulling (reduce tilt, torque_share or pusher.height)";
+      check.problems.push_back(text.str());
+      reported = true;
+    }
+  }
+  // A prescribed shear is held by rigid sticking only up to each block's static threshold; beyond it
+  // the block would slide at t = 0, before any event could be detected. The pusher holds the sum.
+  const std::vector<double>& shear_profile = s.chain.initial_shear;
+  if (!shear_profile.empty()) {
+    double held_by_pusher = 0.0;
+    for (double f : shear_profile) held_by_pusher -= f;
+    const std::vector<double> w = chain.normalForces(held_by_pusher);
+    for (std::size_t i = 0; i < shear_profile.size(); ++i) {
+      const double threshold = s.friction.static_coefficient * std::max(w[i], 0.0);
+      if (std::abs(shear_profile[i]) <= threshold) continue;
+      std::ostringstream allowed;
+      allowed << "|f| <= mu_s * w_" << i << " = " << threshold << " N, the block's static threshold with the pusher "
+              << "holding F_X = " << held_by_pusher << " N";
+      check.require(false, "chain.initial_shear[" + std::to_string(i) + "]", shear_profile[i], allowed.str());
+    }
+  }
+}
+
+/// dt against the stability limit of the scene, which it returns.
+double checkTimeStep(Checker& check, const Scene& s) {
+  const double limit = sceneStabilityLimit(s);
+  std::ostringstream allowed;
+  allowed.precision(4);
+  allowed << "dt < " << limit << " s, the stability limit of this scene for "
+          << (s.integrator.scheme == IntegratorKind::RungeKutta4 ? "rk4" : "velocity_verlet");
+  check.require(s.integrator.time_step < limit, "integrator.time_step", s.integrator.time_step, allowed.str());
+  return limit;
+}
+
+}  // namespace
+
+double largestNormalForce(const Scene& scene) {
+  return 0.05 * scene.material.youngs_modulus * scene.geometry.length * scene.geometry.width;
+}
+
+std::vector<std::string> validateScene(const Scene& s, double* stability_limit) {
+  Checker check;
+  const bool lattice = s.model == ModelKind::Lattice2D;
+  checkBody(check, s);
+  if (lattice) {
+    checkLattice(check, s);
+  } else {
+    checkChain(check, s);
+  }
+  checkFriction(check, s);
+  checkLoad(check, s);
+  checkPusher(check, s);
+  checkStage(check, s);
+  checkInstrumentsStopAndIntegrator(check, s);
   // Cross-field checks that need a consistent model; run whenever the fields they use are valid, so
   // that one refusal lists everything.
   const bool model_valid = check.clean({"geometry.", "material.", "lattice.", "chain.", "pusher.", "load.",
@@ -187,48 +262,9 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
     }
     return check.problems;
   }
-  if (!lattice && check.clean({"friction.static_coefficient"})) {
-    const Chain1D chain(s);
-    // |F_X| stays below the interface's total static friction µ_s·F_Z, in either direction: the stage
-    // program or the controller may drive the stage back. w_i is linear in F_X, so the ends suffice.
-    const double most_shear = mu_s * s.load.normal_force;
-    bool reported = false;
-    for (double shear : {0.0, most_shear, -most_shear}) {
-      const std::vector<double> w = chain.normalForces(shear);
-      for (std::size_t i = 0; i < w.size() && !reported; ++i) {
-        if (w[i] > 0.0) continue;
-        std::ostringstream text;
-        text << "chain.tilt/chain.torque_share: the normal force of block " << i << " would be " << w[i]
-             << " N at F_X = " << shear << " N; allowed: every block's normal force w_i > 0 for F_X in [" << -most_shear
-             << ", " << most_shear << "] N, the stage pushing or pulling (reduce tilt, torque_share or pusher.height)";
-        check.problems.push_back(text.str());
-        reported = true;
-      }
-    }
-    // A prescribed shear is held by rigid sticking only up to each block's static threshold; beyond it
-    // the block would slide at t = 0, before any event could be detected. The pusher holds the sum.
-    const std::vector<double>& shear_profile = s.chain.initial_shear;
-    if (!shear_profile.empty()) {
-      double held_by_pusher = 0.0;
-      for (double f : shear_profile) held_by_pusher -= f;
-      const std::vector<double> w = chain.normalForces(held_by_pusher);
-      for (std::size_t i = 0; i < shear_profile.size(); ++i) {
-        const double threshold = mu_s * std::max(w[i], 0.0);
-        if (std::abs(shear_profile[i]) <= threshold) continue;
-        std::ostringstream allowed;
-        allowed << "|f| <= mu_s * w_" << i << " = " << threshold << " N, the block's static threshold with the pusher "
-                << "holding F_X = " << held_by_pusher << " N";
-        check.require(false, "chain.initial_shear[" + std::to_string(i) + "]", shear_profile[i], allowed.str());
-      }
-    }
-  }
-  const double limit = sceneStabilityLimit(s);
+  if (!lattice && check.clean({"friction.static_coefficient"})) checkChainStatics(check, s);
+  const double limit = checkTimeStep(check, s);
   if (stability_limit) *stability_limit = limit;
-  std::ostringstream allowed;
-  allowed.precision(4);
-  allowed << "dt < " << limit << " s, the stability limit of this scene for "
-          << (s.integrator.scheme == IntegratorKind::RungeKutta4 ? "rk4" : "velocity_verlet");
-  check.require(s.integrator.time_step < limit, "integrator.time_step", s.integrator.time_step, allowed.str());
   return check.problems;
 }
 
