@@ -30,8 +30,8 @@ class RunStream {
   /// True if a jump also ends at nextTime() where jumps are cut at frames (RunOptions::cut_jumps_at_frames,
   /// and in a rest with no end).
   virtual bool cutsJumps() const { return false; }
-  /// Before each advance, after the commands due were applied.
-  virtual void before(const Simulation& /*simulation*/) {}
+  /// Before each advance, after the commands due were applied (`commands_applied` if any was).
+  virtual void before(const Simulation& /*simulation*/, bool /*commands_applied*/) {}
   /// After each advance; `jumped` if it was a fast-forward jump.
   virtual void after(const Simulation& simulation, bool jumped) = 0;
 };
@@ -72,16 +72,20 @@ class SampledStream : public RunStream {
   /// True if the last advance produced a sample.
   bool sampledLast() const { return sampled_last_; }
 
-  void before(const Simulation& simulation) override {
-    // A plain step needs no reading before it where samples are taken at steps.
-    if (sampling_ == Sampling::Interpolated || simulation.mayJump()) before_ = read_(simulation);
+  void before(const Simulation& simulation, bool commands_applied) override {
+    // Interpolated, the reading after the last advance serves unless a command changed the state since.
+    // At steps, a plain step needs no reading before it.
+    const bool needed = sampling_ == Sampling::Interpolated ? commands_applied || !before_current_ : simulation.mayJump();
+    if (needed) before_ = read_(simulation);
   }
 
   void after(const Simulation& simulation, bool jumped) override {
     sampled_last_ = false;
     if (jumped || sampling_ == Sampling::Interpolated) {
-      const Reading end = read_(simulation);
+      Reading end = read_(simulation);
       for (; next_ <= simulation.time(); next_ += period_) emit(interpolate(before_, end, next_));
+      before_ = std::move(end);
+      before_current_ = true;
     }
     if (sampling_ != Sampling::AtSteps) return;
     const bool boundary =
@@ -108,6 +112,7 @@ class SampledStream : public RunStream {
   Read read_;
   Sink sink_;
   Reading before_{};
+  bool before_current_ = false;  ///< before_ holds the reading at the end of the last advance
   bool sampled_last_ = false;
 };
 
@@ -121,7 +126,7 @@ class CameraStream : public RunStream {
   CameraStream(double rate, double idle_rate, Sink sink);
   double nextTime() const override { return next_; }
   bool cutsJumps() const override { return true; }
-  void before(const Simulation& simulation) override;
+  void before(const Simulation& simulation, bool commands_applied) override;
   void after(const Simulation& simulation, bool jumped) override;
 
  private:

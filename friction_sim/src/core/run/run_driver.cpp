@@ -7,7 +7,7 @@ namespace friction {
 CameraStream::CameraStream(double rate, double idle_rate, Sink sink)
     : rate_(rate), idle_rate_(idle_rate), next_(1.0 / idle_rate), sink_(std::move(sink)) {}
 
-void CameraStream::before(const Simulation& simulation) {
+void CameraStream::before(const Simulation& simulation, bool /*commands_applied*/) {
   if (simulation.mayJump()) before_ = simulation.interfaceFrame();
 }
 
@@ -56,13 +56,13 @@ double RunDriver::jumpEnd() const {
 }
 
 void RunDriver::advance() {
-  schedule_.applyDue(simulation_, command_due_);
+  const bool commands_applied = schedule_.applyDue(simulation_, command_due_) > 0;
   const double until = jumpEnd();
   // Plain steps are taken several at once only where none of them ends at or after a stream's sample
   // time: every stream sees the steps it samples.
   double group_before = until;
   for (const auto& stream : streams_) group_before = std::min(group_before, stream->nextTime());
-  for (const auto& stream : streams_) stream->before(simulation_);
+  for (const auto& stream : streams_) stream->before(simulation_, commands_applied);
   const long long jumps = simulation_.jumps();
   simulation_.advance(until, group_before);
   const bool jumped = simulation_.jumps() != jumps;
