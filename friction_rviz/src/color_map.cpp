@@ -63,7 +63,9 @@ std::string fieldLabel(Field field) {
   return "speed (m/s)";
 }
 
-bool signedField(Field field) { return field == Field::SigmaZZ || field == Field::TauXZ || field == Field::StressRatio; }
+bool signedField(Field field) {
+  return field == Field::SigmaZZ || field == Field::TauXZ || field == Field::StressRatio;
+}
 
 std::vector<double> fieldValues(Field field, const std::vector<double>& sigma_xx, const std::vector<double>& sigma_zz,
                                 const std::vector<double>& tau_xz, const std::vector<double>& speed) {

@@ -12,8 +12,8 @@ namespace friction_rviz {
 
 /// Moves `node` to the pose of `header`'s frame and sets the display's "Transform" status. Without a
 /// transform the status is an error naming the frame (logged at most every 5 s) and false is returned.
-inline bool placeAtMessageFrame(rviz::Display& display, rviz::DisplayContext& context,
-                                const std_msgs::Header& header, Ogre::SceneNode& node) {
+inline bool placeAtMessageFrame(rviz::Display& display, rviz::DisplayContext& context, const std_msgs::Header& header,
+                                Ogre::SceneNode& node) {
   Ogre::Vector3 position;
   Ogre::Quaternion orientation;
   if (!context.getFrameManager()->getTransform(header, position, orientation)) {

@@ -9,15 +9,15 @@
 
 #include <cmath>
 
-#include "friction_rviz/color_map.h"
 #include "frame_placement.h"
+#include "friction_rviz/color_map.h"
 #include "vertex_colour_material.h"
 
 namespace friction_rviz {
 
 InterfaceDisplay::InterfaceDisplay() : history_(300) {
-  rows_ = new rviz::IntProperty("History", 300, "Frames kept in the strip (older ones scroll out).", this,
-                                SLOT(resize()));
+  rows_ =
+      new rviz::IntProperty("History", 300, "Frames kept in the strip (older ones scroll out).", this, SLOT(resize()));
   rows_->setMin(2);
   rows_->setMax(5000);
   field_ = new rviz::EnumProperty("Field", "slip velocity", "What the strip shows.", this, SLOT(markDirty()));
@@ -25,8 +25,8 @@ InterfaceDisplay::InterfaceDisplay() : history_(300) {
   field_->addOption("slip", 1);
   height_ = new rviz::FloatProperty("Strip height", 0.06, "Height of the strip in the slider frame (m).", this,
                                     SLOT(markDirty()));
-  offset_ = new rviz::FloatProperty("Strip base", 0.09, "z of the strip's bottom (newest) row (m).", this,
-                                    SLOT(markDirty()));
+  offset_ =
+      new rviz::FloatProperty("Strip base", 0.09, "z of the strip's bottom (newest) row (m).", this, SLOT(markDirty()));
   scale_ = new rviz::FloatProperty("Full scale", 0.0,
                                    "Value drawn at full colour (m/s or m); 0 takes the largest in the strip.", this,
                                    SLOT(markDirty()));
@@ -88,15 +88,16 @@ void InterfaceDisplay::redraw() {
   const double half = 0.5 * (x[1] - x[0]);
   // Newest row at the base, older rows above it.
   auto row_z = [&](std::size_t r) { return base + row_height * static_cast<float>(rows - 1 - r); };
-  strip_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_TRIANGLE_LIST, Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
+  strip_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_TRIANGLE_LIST,
+                Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
   for (std::size_t r = 0; r < rows; ++r) {
     const auto& row = history_.row(r);
     const float z0 = row_z(r), z1 = z0 + row_height;
     for (std::size_t i = 0; i < row.size() && i < x.size(); ++i) {
       // Black at rest, through red to yellow at full scale: the camera's |dA/dt| picture.
       const double s = std::min(std::abs(row[i]) / range.max, 1.0);
-      const Ogre::ColourValue c(static_cast<float>(std::min(1.0, 2.0 * s)), static_cast<float>(std::max(0.0, 2.0 * s - 1.0)),
-                                0.05f);
+      const Ogre::ColourValue c(static_cast<float>(std::min(1.0, 2.0 * s)),
+                                static_cast<float>(std::max(0.0, 2.0 * s - 1.0)), 0.05f);
       const float xa = static_cast<float>(x[i] - half), xb = static_cast<float>(x[i] + half);
       for (const auto& p : {Ogre::Vector3(xa, 0, z0), Ogre::Vector3(xb, 0, z0), Ogre::Vector3(xb, 0, z1),
                             Ogre::Vector3(xa, 0, z0), Ogre::Vector3(xb, 0, z1), Ogre::Vector3(xa, 0, z1)}) {
@@ -109,7 +110,8 @@ void InterfaceDisplay::redraw() {
   // Event outlines: a box over the event's rows and slipped range; its top edge marks L_p.
   const std::vector<StripEvent> events = history_.visibleEvents();
   if (events.empty()) return;
-  strip_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_LINE_LIST, Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
+  strip_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_LINE_LIST,
+                Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
   const Ogre::ColourValue outline(0.2f, 0.9f, 1.0f);
   for (const StripEvent& event : events) {
     const float xa = static_cast<float>(event.x_min - half), xb = static_cast<float>(event.x_max + half);

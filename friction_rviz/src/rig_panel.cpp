@@ -95,8 +95,8 @@ void PlotWidget::paintEvent(QPaintEvent*) {
       } else {
         painter.drawLine(key - QPointF(7, 0), key + QPointF(7, 0));
       }
-      painter.drawText(QRectF(keys[i].x() + kKey - 10, keys[i].y(), area.width(), kRow), Qt::AlignLeft | Qt::AlignVCenter,
-                       s.label);
+      painter.drawText(QRectF(keys[i].x() + kKey - 10, keys[i].y(), area.width(), kRow),
+                       Qt::AlignLeft | Qt::AlignVCenter, s.label);
     }
     if (s.points) {
       for (std::size_t i = 0; i < s.x.size(); ++i) painter.drawEllipse(map(s.x[i], s.y[i]), 3, 3);
@@ -193,9 +193,7 @@ void RigPanel::onEvent(const friction_msgs::SlipEvent::ConstPtr& msg) {
               msg->global_event, msg->mean_slip < 0.0);
 }
 
-void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) {
-  last_state_ = *msg;
-}
+void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) { last_state_ = *msg; }
 
 void RigPanel::refresh() {
   auto series = [](std::vector<double> x, std::vector<double> y, QColor colour, const char* label) {
@@ -239,7 +237,8 @@ void RigPanel::send(const friction_msgs::StageCommand& command) {
   friction_msgs::SendStageCommand call;
   call.request.command = command;
   const bool ok = command_client_.call(call);
-  reply_label_->setText(QString::fromStdString("reply: " + replyText(ok, call.response.accepted, call.response.reason)));
+  reply_label_->setText(
+      QString::fromStdString("reply: " + replyText(ok, call.response.accepted, call.response.reason)));
 }
 
 void RigPanel::drive() { send(driveCommand(speed_->value())); }

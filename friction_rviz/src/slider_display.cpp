@@ -12,8 +12,8 @@
 #include <iomanip>
 #include <sstream>
 
-#include "friction_rviz/color_map.h"
 #include "frame_placement.h"
+#include "friction_rviz/color_map.h"
 #include "vertex_colour_material.h"
 
 namespace friction_rviz {
@@ -40,14 +40,14 @@ SliderDisplay::SliderDisplay() {
   field_->addOption("tau/sigma", static_cast<int>(Field::StressRatio));
   field_->addOption("von Mises", static_cast<int>(Field::VonMises));
   field_->addOption("speed", static_cast<int>(Field::Speed));
-  auto_range_ = new rviz::BoolProperty("Auto range", true, "Take the colour range from each snapshot.", this,
-                                       SLOT(markDirty()));
+  auto_range_ =
+      new rviz::BoolProperty("Auto range", true, "Take the colour range from each snapshot.", this, SLOT(markDirty()));
   range_min_ = new rviz::FloatProperty("Range min", -2e6, "Value drawn fully blue (when not automatic).", this,
                                        SLOT(markDirty()));
-  range_max_ = new rviz::FloatProperty("Range max", 2e6, "Value drawn fully red (when not automatic).", this,
-                                       SLOT(markDirty()));
-  draw_springs_ = new rviz::BoolProperty("Springs", true, "Draw the springs, not only the interface.", this,
-                                         SLOT(markDirty()));
+  range_max_ =
+      new rviz::FloatProperty("Range max", 2e6, "Value drawn fully red (when not automatic).", this, SLOT(markDirty()));
+  draw_springs_ =
+      new rviz::BoolProperty("Springs", true, "Draw the springs, not only the interface.", this, SLOT(markDirty()));
 }
 
 SliderDisplay::~SliderDisplay() {
@@ -130,7 +130,8 @@ void SliderDisplay::redraw() {
     return Ogre::ColourValue(c.r, c.g, c.b);
   };
   lattice_->clear();
-  lattice_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_LINE_LIST, Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
+  lattice_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_LINE_LIST,
+                  Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
   auto spring = [&](int a, int b) {
     lattice_->position(point(a));
     lattice_->colour(colour(a));
@@ -152,7 +153,8 @@ void SliderDisplay::redraw() {
 
   // The interface band (stuck/sliding), the pusher arrow, the top load and the colour bar.
   overlay_->clear();
-  overlay_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_TRIANGLE_LIST, Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
+  overlay_->begin(vertexColourMaterial(), Ogre::RenderOperation::OT_TRIANGLE_LIST,
+                  Ogre::ResourceGroupManager::DEFAULT_RESOURCE_GROUP_NAME);
   auto quad = [&](const Ogre::Vector3& a, const Ogre::Vector3& b, const Ogre::Vector3& c, const Ogre::Vector3& d,
                   const Ogre::ColourValue& colour) {
     for (const Ogre::Vector3& p : {a, b, c, a, c, d}) {
@@ -165,8 +167,9 @@ void SliderDisplay::redraw() {
     const Rgb c = contactColor(m.interface_state[i]);
     const Ogre::Vector3 p = point(i);
     const float half = static_cast<float>(0.5 * l);
-    quad(p + Ogre::Vector3(-half, 0, -band), p + Ogre::Vector3(half, 0, -band), p + Ogre::Vector3(half, 0, -0.1f * band),
-         p + Ogre::Vector3(-half, 0, -0.1f * band), Ogre::ColourValue(c.r, c.g, c.b));
+    quad(p + Ogre::Vector3(-half, 0, -band), p + Ogre::Vector3(half, 0, -band),
+         p + Ogre::Vector3(half, 0, -0.1f * band), p + Ogre::Vector3(-half, 0, -0.1f * band),
+         Ogre::ColourValue(c.r, c.g, c.b));
   }
   const Ogre::ColourValue dark(0.1f, 0.1f, 0.1f);
   const float arrow = static_cast<float>(4 * l);
@@ -181,7 +184,8 @@ void SliderDisplay::redraw() {
   if (nz > 1) {
     for (int i = 0; i < nx; i += std::max(1, nx / 8)) {
       const Ogre::Vector3 top = point((nz - 1) * nx + i) + Ogre::Vector3(0, 0, 0.3f * static_cast<float>(l));
-      quad(top + Ogre::Vector3(-0.15f * static_cast<float>(l), 0, 0), top + Ogre::Vector3(0.15f * static_cast<float>(l), 0, 0),
+      quad(top + Ogre::Vector3(-0.15f * static_cast<float>(l), 0, 0),
+           top + Ogre::Vector3(0.15f * static_cast<float>(l), 0, 0),
            top + Ogre::Vector3(0.15f * static_cast<float>(l), 0, 2.5f * static_cast<float>(l)),
            top + Ogre::Vector3(-0.15f * static_cast<float>(l), 0, 2.5f * static_cast<float>(l)), dark);
     }
@@ -199,8 +203,9 @@ void SliderDisplay::redraw() {
   overlay_->end();
   // The range also goes into the display's status: the labels need rviz's fonts, which some rviz
   // builds do not load.
-  setStatus(rviz::StatusProperty::Ok, "Colour range",
-            QString::fromStdString(fieldLabel(field) + ": " + shortNumber(range.min) + " to " + shortNumber(range.max)));
+  setStatus(
+      rviz::StatusProperty::Ok, "Colour range",
+      QString::fromStdString(fieldLabel(field) + ": " + shortNumber(range.min) + " to " + shortNumber(range.max)));
   min_label_->setCaption(shortNumber(range.min));
   max_label_->setCaption(shortNumber(range.max));
   title_label_->setCaption(fieldLabel(field));

@@ -2,8 +2,8 @@
 #pragma once
 
 #include <OGRE/OgreMaterialManager.h>
-#include <OGRE/OgreResourceGroupManager.h>
 #include <OGRE/OgrePass.h>
+#include <OGRE/OgreResourceGroupManager.h>
 #include <OGRE/OgreTechnique.h>
 
 #include <string>

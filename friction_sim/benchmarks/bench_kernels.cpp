@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/solvers/integrator.h"
-#include "friction_sim/scene/scene_io.h"
 #include "friction_sim/run/simulation.h"
+#include "friction_sim/scene/scene_io.h"
+#include "friction_sim/solvers/integrator.h"
 
 namespace friction {
 namespace {
@@ -67,8 +67,8 @@ void advanceAndCount(benchmark::State& state, Simulation& simulation, double nod
 
 /// The lattice of the case's (nx, nz) with springs of `form`, built once for its consecutive cases.
 Simulation& reusedLattice(const benchmark::State& state, SpringForm form) {
-  const std::string key = "lattice/" + std::to_string(static_cast<int>(form)) + "/" +
-                          std::to_string(state.range(0)) + "/" + std::to_string(state.range(1));
+  const std::string key = "lattice/" + std::to_string(static_cast<int>(form)) + "/" + std::to_string(state.range(0)) +
+                          "/" + std::to_string(state.range(1));
   return reusedSimulation(key, [&] {
     Scene scene = latticeScene(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
     scene.lattice.spring_form = form;
@@ -82,18 +82,29 @@ void latticeStep(benchmark::State& state, SpringForm form) {
   state.counters["nodes"] = nodes;
 }
 // The 10⁶-node lattice last, so that the next case reuses it.
-BENCHMARK_CAPTURE(latticeStep, geometric, SpringForm::Geometric)->Args({57, 31})->Args({32, 32})->Args({33, 31})->Args({113, 61})->Args({225, 121})->Args({449, 241})
-    ->Args({1001, 61})->Args({1001, 1001})->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(latticeStep, geometric, SpringForm::Geometric)
+    ->Args({57, 31})
+    ->Args({32, 32})
+    ->Args({33, 31})
+    ->Args({113, 61})
+    ->Args({225, 121})
+    ->Args({449, 241})
+    ->Args({1001, 61})
+    ->Args({1001, 1001})
+    ->Unit(benchmark::kMicrosecond);
 
 /// The same lattice stepped one step per advance, each step a sweep of its own: what sweeping several
 /// steps at once saves.
 void latticeStepOneAtATime(benchmark::State& state) {
   Simulation& simulation = reusedLattice(state, SpringForm::Geometric);
   for (auto _ : state) simulation.step();
-  state.counters["ns_per_node_step"] = nsPerNodeStep(static_cast<double>(state.range(0) * state.range(1)) * static_cast<double>(state.iterations()));
+  state.counters["ns_per_node_step"] =
+      nsPerNodeStep(static_cast<double>(state.range(0) * state.range(1)) * static_cast<double>(state.iterations()));
 }
 BENCHMARK(latticeStepOneAtATime)->Args({1001, 1001})->Args({57, 31})->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(latticeStep, linearised, SpringForm::Linearised)->Args({57, 31})->Args({449, 241})
+BENCHMARK_CAPTURE(latticeStep, linearised, SpringForm::Linearised)
+    ->Args({57, 31})
+    ->Args({449, 241})
     ->Unit(benchmark::kMicrosecond);
 
 void chainStep(benchmark::State& state) {
@@ -138,7 +149,8 @@ void stateStream(benchmark::State& state) {
     }
     benchmark::ClobberMemory();
   }
-  state.counters["ns_per_node_step"] = nsPerNodeStep(static_cast<double>(nodes) * static_cast<double>(state.iterations()));
+  state.counters["ns_per_node_step"] =
+      nsPerNodeStep(static_cast<double>(nodes) * static_cast<double>(state.iterations()));
 }
 BENCHMARK(stateStream)->Arg(57 * 31)->Arg(1001 * 1001)->Unit(benchmark::kMicrosecond);
 
@@ -162,7 +174,8 @@ void leapfrogStream(benchmark::State& state) {
     }
     benchmark::ClobberMemory();
   }
-  state.counters["ns_per_node_step"] = nsPerNodeStep(static_cast<double>(nodes) * static_cast<double>(state.iterations()));
+  state.counters["ns_per_node_step"] =
+      nsPerNodeStep(static_cast<double>(nodes) * static_cast<double>(state.iterations()));
 }
 BENCHMARK(leapfrogStream)->Arg(57 * 31)->Arg(1001 * 1001)->Unit(benchmark::kMicrosecond);
 
@@ -185,7 +198,8 @@ void bondDividerFloor(benchmark::State& state) {
     benchmark::DoNotOptimize(tension_per_length.data());
     benchmark::ClobberMemory();
   }
-  state.counters["ns_per_node_step"] = nsPerNodeStep(static_cast<double>(nx * nz) * static_cast<double>(state.iterations()));
+  state.counters["ns_per_node_step"] =
+      nsPerNodeStep(static_cast<double>(nx * nz) * static_cast<double>(state.iterations()));
 }
 BENCHMARK(bondDividerFloor)->Unit(benchmark::kMicrosecond);
 

@@ -34,13 +34,13 @@
 #include <memory>
 #include <sstream>
 
-#include "friction_sim/run/run_driver.h"
-#include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/instruments/results_io.h"
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
-#include "friction_sim/scene/scene_io.h"
+#include "friction_sim/run/run_driver.h"
 #include "friction_sim/run/simulation.h"
+#include "friction_sim/scene/loading_protocol.h"
+#include "friction_sim/scene/scene_io.h"
 
 namespace friction {
 namespace {
@@ -189,19 +189,20 @@ void runRefusedProtocol() {
 void runProtocolAgainstARefusingSimulator(const std::string& protocol) {
   StandInSimulator simulator("/refused_command");
   simulator.answer<friction_msgs::SendStageCommand>(
-      "send_command", [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
+      "send_command",
+      [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
         response.accepted = false;
         response.reason = "speed 2 m/s exceeds the stage's max_speed 1 m/s";
       });
   simulator.countCalls("abort", g_seen.aborts_after_refused_command);
   simulator.countCalls("stop", g_seen.stops_after_refused_command);
-  simulator.answer<std_srvs::SetBool>("pause", [](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
-    if (!request.data) ++g_seen.unpauses_after_refused_command;
-    response.success = true;
-  });
+  simulator.answer<std_srvs::SetBool>("pause",
+                                      [](std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response) {
+                                        if (!request.data) ++g_seen.unpauses_after_refused_command;
+                                        response.success = true;
+                                      });
   simulator.announce(0, 0.0, 0, true);
-  g_seen.refused_command_status =
-      simulator.runController(protocol, "_start_delay:=0", g_seen.refused_command_output);
+  g_seen.refused_command_status = simulator.runController(protocol, "_start_delay:=0", g_seen.refused_command_output);
 }
 
 /// A controller whose simulator is reset while it waits to start: the stand-in announces t = 0, takes
@@ -227,7 +228,8 @@ void runControllerThroughAFailedCall(const std::string& protocol) {
   int run_ends = 0;  // outlives the stand-in's services
   StandInSimulator simulator("/failed_call");
   simulator.serve<friction_msgs::SendStageCommand>(
-      "send_command", [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
+      "send_command",
+      [](friction_msgs::SendStageCommand::Request&, friction_msgs::SendStageCommand::Response& response) {
         response.accepted = true;
         return ++g_seen.commands_with_a_failed_call > 1;
       });
@@ -353,7 +355,8 @@ TEST(FullRun, LatticeSnapshotsShowTheLoadedSlider) {
   ASSERT_EQ(lattice.nodes_x, static_cast<unsigned>(scene.lattice.nodes_x));
   ASSERT_EQ(lattice.nodes_z, static_cast<unsigned>(scene.lattice.nodes_z));
   const std::size_t nodes = lattice.nodes_x * lattice.nodes_z;
-  for (const auto* field : {&lattice.x, &lattice.z, &lattice.speed, &lattice.sigma_xx, &lattice.sigma_zz, &lattice.tau_xz}) {
+  for (const auto* field :
+       {&lattice.x, &lattice.z, &lattice.speed, &lattice.sigma_xx, &lattice.sigma_zz, &lattice.tau_xz}) {
     ASSERT_EQ(field->size(), nodes);
   }
   ASSERT_EQ(lattice.interface_state.size(), lattice.nodes_x);
@@ -570,29 +573,42 @@ TEST(KillRun, BagIsReadableAndHoldsEverythingUpToTheKill) {
 void watchFullRun(ros::NodeHandle& nh) {
   auto rig = std::make_shared<ros::NodeHandle>("/rig");
   std::vector<ros::Subscriber> subs;
-  subs.push_back(listen<friction_msgs::SlipEvent>(nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); }));
-  subs.push_back(listen<friction_msgs::PrecursorPoint>(nh, "/rig/precursor_detector/precursor_points", [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.live_points.push_back(*m); }));
-  subs.push_back(listen<friction_msgs::PrecursorPoint>(nh, "/replay/precursor_detector/precursor_points", [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.replay_points.push_back(*m); }));
-  subs.push_back(listen<friction_msgs::SlipEvent>(nh, "/rig/precursor_detector/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.live_detector_events.push_back(*m); }));
-  subs.push_back(listen<friction_msgs::SlipEvent>(nh, "/replay/precursor_detector/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.replay_detector_events.push_back(*m); }));
-  subs.push_back(listen<rosgraph_msgs::Clock>(nh, "/clock", [](const rosgraph_msgs::Clock::ConstPtr& m) { g_seen.clock.push_back(m->clock.toSec()); }));
-  subs.push_back(listen<friction_msgs::StrainGaugeProfile>(nh, "/rig/strain_gauges", [](const friction_msgs::StrainGaugeProfile::ConstPtr&) { ++g_seen.gauge_profiles; }));
-  subs.push_back(listen<friction_msgs::StageState>(nh, "/rig/stage_state", [](const friction_msgs::StageState::ConstPtr& m) {
-                                                           ++g_seen.stage_states;
-                                                           g_seen.last_stage_time = m->header.stamp.toSec();
-                                                         }));
-  subs.push_back(listen<friction_msgs::LatticeSnapshot>(nh, "/rig/lattice", [](const friction_msgs::LatticeSnapshot::ConstPtr& m) {
-                                                                ++g_seen.lattice_snapshots;
-                                                                g_seen.last_lattice = *m;
-                                                              }));
+  subs.push_back(listen<friction_msgs::SlipEvent>(
+      nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); }));
+  subs.push_back(listen<friction_msgs::PrecursorPoint>(
+      nh, "/rig/precursor_detector/precursor_points",
+      [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.live_points.push_back(*m); }));
+  subs.push_back(listen<friction_msgs::PrecursorPoint>(
+      nh, "/replay/precursor_detector/precursor_points",
+      [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.replay_points.push_back(*m); }));
+  subs.push_back(listen<friction_msgs::SlipEvent>(
+      nh, "/rig/precursor_detector/slip_events",
+      [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.live_detector_events.push_back(*m); }));
+  subs.push_back(listen<friction_msgs::SlipEvent>(
+      nh, "/replay/precursor_detector/slip_events",
+      [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.replay_detector_events.push_back(*m); }));
+  subs.push_back(listen<rosgraph_msgs::Clock>(
+      nh, "/clock", [](const rosgraph_msgs::Clock::ConstPtr& m) { g_seen.clock.push_back(m->clock.toSec()); }));
+  subs.push_back(listen<friction_msgs::StrainGaugeProfile>(
+      nh, "/rig/strain_gauges", [](const friction_msgs::StrainGaugeProfile::ConstPtr&) { ++g_seen.gauge_profiles; }));
+  subs.push_back(
+      listen<friction_msgs::StageState>(nh, "/rig/stage_state", [](const friction_msgs::StageState::ConstPtr& m) {
+        ++g_seen.stage_states;
+        g_seen.last_stage_time = m->header.stamp.toSec();
+      }));
+  subs.push_back(
+      listen<friction_msgs::LatticeSnapshot>(nh, "/rig/lattice", [](const friction_msgs::LatticeSnapshot::ConstPtr& m) {
+        ++g_seen.lattice_snapshots;
+        g_seen.last_lattice = *m;
+      }));
   // Bad commands to the rig while it waits for its controller (5 s here: with fast-forward the run itself
   // is over in a tenth of a second, and calls made while it ran could come after it had ended); then a
   // bad scene and a bad parameter for a second simulator.
   ros::service::waitForService("/rig/send_command", ros::Duration(60.0));
   ros::ServiceClient client = nh.serviceClient<friction_msgs::SendStageCommand>("/rig/send_command");
-  for (auto [mode, speed, load] : {std::tuple<int, double, double>{0, std::nan(""), 0.0},
-                                   std::tuple<int, double, double>{3, 0.0, -5.0},
-                                   std::tuple<int, double, double>{0, 50.0, 0.0}}) {
+  for (auto [mode, speed, load] :
+       {std::tuple<int, double, double>{0, std::nan(""), 0.0}, std::tuple<int, double, double>{3, 0.0, -5.0},
+        std::tuple<int, double, double>{0, 50.0, 0.0}}) {
     friction_msgs::SendStageCommand call;
     call.request.command.mode = mode;
     call.request.command.speed = speed;
@@ -608,17 +624,17 @@ void watchFullRun(ros::NodeHandle& nh) {
   std::FILE* file = std::fopen(bad_scene.c_str(), "w");
   std::fputs("friction: {kinetic_coefficient: 0.9}\npusher: {height: 1.0}\n", file);
   std::fclose(file);
-  g_seen.bad_scene_status = runCommand("rosrun friction_sim rig_simulator __name:=bad_scene _scene:=" + bad_scene,
-                                       g_seen.bad_scene_output);
+  g_seen.bad_scene_status =
+      runCommand("rosrun friction_sim rig_simulator __name:=bad_scene _scene:=" + bad_scene, g_seen.bad_scene_output);
   ros::NodeHandle pnh("~");
   std::string scene;
   pnh.getParam("scene", scene);
-  g_seen.bad_parameter_status = runCommand(
-      "rosrun friction_sim rig_simulator __name:=bad_parameter _load_cell_rate:=-1.0 _scene:=" + scene,
-      g_seen.bad_parameter_output);
-  g_seen.bad_detector_status = runCommand(
-      "rosrun friction_sim precursor_detector __name:=bad_detector _front_fit_nodes:=1 _overrides:=broken",
-      g_seen.bad_detector_output);
+  g_seen.bad_parameter_status =
+      runCommand("rosrun friction_sim rig_simulator __name:=bad_parameter _load_cell_rate:=-1.0 _scene:=" + scene,
+                 g_seen.bad_parameter_output);
+  g_seen.bad_detector_status =
+      runCommand("rosrun friction_sim precursor_detector __name:=bad_detector _front_fit_nodes:=1 _overrides:=broken",
+                 g_seen.bad_detector_output);
   runRefusedProtocol();
   {
     std::string protocol;
@@ -641,7 +657,8 @@ void watchFullRun(ros::NodeHandle& nh) {
 }
 
 void watchKilledRun(ros::NodeHandle& nh) {
-  ros::Subscriber events = listen<friction_msgs::SlipEvent>(nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); });
+  ros::Subscriber events = listen<friction_msgs::SlipEvent>(
+      nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); });
   waitFor([] { return g_seen.events.size() >= 3; }, 240.0);
   std::string output;
   runCommand("rosnode kill /rig/simulator", output);

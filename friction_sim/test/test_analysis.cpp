@@ -6,11 +6,11 @@
 #include <cmath>
 #include <limits>
 
-#include "friction_sim/run/command_schedule.h"
 #include "friction_sim/instruments/frame_event_detector.h"
-#include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/instruments/results_io.h"
+#include "friction_sim/run/command_schedule.h"
 #include "friction_sim/run/simulation.h"
+#include "friction_sim/scene/loading_protocol.h"
 #include "test_helpers.h"
 
 namespace friction {
@@ -144,14 +144,16 @@ TEST(CommandTable, BadTableListsEveryProblemWithItsLine) {
         "run/stage_commands.csv, line 6: time_s 'inf' is not allowed",
         "run/stage_commands.csv, line 6: normal_load needs normal_force_N as a number, got 'abc'"};
     EXPECT_EQ(error.problems().size(), problems.size()) << text;
-    for (const std::string& problem : problems) EXPECT_NE(text.find(problem), std::string::npos) << problem << "\n" << text;
+    for (const std::string& problem : problems)
+      EXPECT_NE(text.find(problem), std::string::npos) << problem << "\n" << text;
   }
   try {
     parseCommandTable("time,mode\n0,hold\n");
     ADD_FAILURE() << "accepted";
   } catch (const ConfigError& error) {
-    EXPECT_NE(std::string(error.what()).find("line 1: the header must be 'time_s,command,speed_m_s,target_m,"
-                                             "normal_force_N', got 'time,mode'"),
+    EXPECT_NE(std::string(error.what())
+                  .find("line 1: the header must be 'time_s,command,speed_m_s,target_m,"
+                        "normal_force_N', got 'time,mode'"),
               std::string::npos)
         << error.what();
   }
@@ -164,8 +166,8 @@ TEST(CommandTable, ARunRefusesWhatItsSceneRefusesAndAppliesTheRest) {
   Simulation simulation(scene);
   const auto commands = parseCommandTable(
       "time_s,command,speed_m_s,target_m,normal_force_N\n"
-      "0,velocity,2.0,,\n"       // beyond stage.max_speed, 1 m/s
-      "0,normal_load,,,-5\n"     // F_Z must be > 0
+      "0,velocity,2.0,,\n"    // beyond stage.max_speed, 1 m/s
+      "0,normal_load,,,-5\n"  // F_Z must be > 0
       "0,normal_load,,,2500\n"
       "0,position,0.001,2e-4,\n");
   EXPECT_NE(simulation.checkCommand(commands[0]).find("exceeds the stage's max_speed"), std::string::npos);
@@ -241,7 +243,7 @@ TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
 
   Scene scene;  // pmma_2d
   const WaveSpeeds c = waveSpeeds(scene);
-  EXPECT_NEAR(c.shear, 968.25, 0.01);         // √(3E/8ρ)
+  EXPECT_NEAR(c.shear, 968.25, 0.01);          // √(3E/8ρ)
   EXPECT_NEAR(c.longitudinal, 1677.05, 0.01);  // √3·c_S, plane stress with ν = 1/3
   // c_R/c_S = ξ solves the Rayleigh equation (2 − ξ²)² = 4·√(1 − ξ²)·√(1 − ξ²·c_S²/c_L²).
   const double k2 = std::pow(c.shear / c.longitudinal, 2);
@@ -437,8 +439,7 @@ TEST(FrameEventDetector, TheSingleBlocksSlipsSpanTheSliderAsTheSimulatorsDo) {
   // simulator's events have.
   Simulation simulation(loadScene(testing::scenePath("single_block")));
   const Scene& scene = simulation.scene();
-  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal,
-                              scene.geometry.length);
+  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal, scene.geometry.length);
   const std::vector<SlipEvent> found = eventsSeenByTheInstruments(simulation, detector);
   ASSERT_EQ(found.size(), 3u);
   expectTheSameEventsAndExtents(found, simulation.events());
@@ -461,8 +462,7 @@ TEST(SlipEvents, ASliderSlidingAsAWholeWithItsTrailingCornerLiftedSlipsGlobally)
   scene.stop.time = 0.05;
   scene.stop.global_events = 1;
   Simulation simulation(scene);
-  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal,
-                              scene.geometry.length);
+  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal, scene.geometry.length);
   const std::vector<SlipEvent> found = eventsSeenByTheInstruments(simulation, detector);
   ASSERT_EQ(simulation.globalEventCount(), 1) << simulation.stopReason();
   const SlipEvent& global = simulation.events().back();
@@ -487,8 +487,7 @@ TEST(FrameEventDetector, AnEventWaitingForItsLastReadingIsGivenWhenTheStreamRest
   // walkthrough). Without that reading it waits; told that no more come, it is given from the rest.
   Simulation simulation(loadScene(testing::scenePath("single_block")));
   const Scene& scene = simulation.scene();
-  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal,
-                              scene.geometry.length);
+  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal, scene.geometry.length);
   double next_cells = 0.0;
   detector.addFrame(simulation.interfaceFrame());  // all stuck
   while (!simulation.eventEndedLastStep()) {

@@ -7,8 +7,8 @@
 
 #include "friction_sim/model/chain_1d.h"
 #include "friction_sim/model/lattice_2d.h"
-#include "friction_sim/solvers/integrator.h"
 #include "friction_sim/run/simulation.h"
+#include "friction_sim/solvers/integrator.h"
 #include "test_helpers.h"
 
 namespace friction {

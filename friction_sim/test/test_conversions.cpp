@@ -8,8 +8,8 @@
 #include "friction_sim/ros/precursor_detector.h"
 #include "friction_sim/ros/rig_simulator.h"
 #include "friction_sim/ros/stage_controller.h"
-#include "friction_sim/scene/scene_io.h"
 #include "friction_sim/scene/config_error.h"
+#include "friction_sim/scene/scene_io.h"
 
 namespace friction {
 namespace {

@@ -29,9 +29,7 @@ constexpr Pin kPins[] = {
 
 void PrintTo(const Pin& pin, std::ostream* out) { *out << pin.scene; }
 
-std::string pinnedEventsPath(const std::string& scene) {
-  return std::string(PINNED_DIR) + "/" + scene + ".events.csv";
-}
+std::string pinnedEventsPath(const std::string& scene) { return std::string(PINNED_DIR) + "/" + scene + ".events.csv"; }
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path);

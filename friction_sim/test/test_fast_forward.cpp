@@ -26,8 +26,7 @@ TEST(FastForward, StaticJumpAgreesWithALongDampedDynamicRelaxation) {
   ASSERT_TRUE(dynamic.events().empty());
   const double scale = dynamic.displacements().lpNorm<Eigen::Infinity>();
   EXPECT_LT((jumping.displacements() - dynamic.displacements()).lpNorm<Eigen::Infinity>(), 1e-6 * scale);
-  EXPECT_NEAR(jumping.loadCells().shear_force, dynamic.loadCells().shear_force,
-              1e-6 * dynamic.loadCells().shear_force);
+  EXPECT_NEAR(jumping.loadCells().shear_force, dynamic.loadCells().shear_force, 1e-6 * dynamic.loadCells().shear_force);
 }
 
 TEST(FastForward, InstrumentsInterpolatedAcrossAJumpReadWhatAJumpCutThereGives) {
@@ -49,8 +48,8 @@ TEST(FastForward, InstrumentsInterpolatedAcrossAJumpReadWhatAJumpCutThereGives) 
   const InterfaceFrame frame_after = whole.interfaceFrame();
   const LatticeSnapshot lattice_after = whole.snapshot();
   auto expectClose = [](const std::vector<double>& before, const std::vector<double>& after,
-                        const std::vector<double>& interpolated, const std::vector<double>& reached,
-                        double tolerance, const char* what) {
+                        const std::vector<double>& interpolated, const std::vector<double>& reached, double tolerance,
+                        const char* what) {
     ASSERT_EQ(interpolated.size(), reached.size()) << what;
     double change = 0.0, largest_difference = 0.0;
     for (std::size_t i = 0; i < reached.size(); ++i) {
@@ -66,8 +65,8 @@ TEST(FastForward, InstrumentsInterpolatedAcrossAJumpReadWhatAJumpCutThereGives) 
   EXPECT_EQ(frame.state, frame_cut.state);
   expectClose(frame_before.normal_force, frame_after.normal_force, frame.normal_force, frame_cut.normal_force, 1e-3,
               "normal force");
-  expectClose(frame_before.friction_force, frame_after.friction_force, frame.friction_force,
-              frame_cut.friction_force, 3e-3, "friction force");
+  expectClose(frame_before.friction_force, frame_after.friction_force, frame.friction_force, frame_cut.friction_force,
+              3e-3, "friction force");
   const LatticeSnapshot lattice = interpolate(lattice_before, lattice_after, 0.002);
   const LatticeSnapshot lattice_cut = cut.snapshot();
   expectClose(lattice_before.x, lattice_after.x, lattice.x, lattice_cut.x, 1e-3, "x");
@@ -226,7 +225,8 @@ TEST(FastForward, GoesOnWithTheTrailingEdgeLiftedAndAgreesWithFullDynamics) {
 
 TEST(FastForward, StopAndGoAndNormalLoadChangesStayOnTheStaticPath) {
   Scene scene = testing::coarseSliderScene(true);
-  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.01}, StageSegment{StageMode::Hold, 0.0, 0.0, 0.01},
+  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.01},
+                         StageSegment{StageMode::Hold, 0.0, 0.0, 0.01},
                          StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.01}};
   Simulation simulation(scene);
   while (simulation.time() < 0.015) simulation.advance(0.015);
@@ -250,8 +250,9 @@ TEST(FastForward, StageProgramKeepsItsTravelWhenJumpsStopShortOfThresholds) {
   Scene scene = testing::coarseSliderScene(true);
   scene.load.normal_force = 100.0;
   scene.pusher.height = 0.075;
-  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.004}, StageSegment{StageMode::Hold, 0.0, 0.0, 0.002},
-                         StageSegment{StageMode::Velocity, -4e-3, 0.0, 0.004}, StageSegment{StageMode::Hold, 0.0, 0.0, 1.0}};
+  scene.stage.program = {
+      StageSegment{StageMode::Velocity, 4e-3, 0.0, 0.004}, StageSegment{StageMode::Hold, 0.0, 0.0, 0.002},
+      StageSegment{StageMode::Velocity, -4e-3, 0.0, 0.004}, StageSegment{StageMode::Hold, 0.0, 0.0, 1.0}};
   scene.stop.global_events = 0;
   scene.stop.time = 0.02;
   Simulation simulation(scene);

@@ -2,8 +2,8 @@
 // crossing, weakening over ξ_µ, loss and return of contact, the elastic anchor k_T.
 #include <gtest/gtest.h>
 
-#include "friction_sim/model/chain_1d.h"
 #include "friction_sim/contact/contact_interface.h"
+#include "friction_sim/model/chain_1d.h"
 
 namespace friction {
 namespace {
@@ -181,7 +181,7 @@ TEST_F(OneNode, NodeSlidingOffOnLandingUnsticksAtTheEndOfTheStep) {
 
 TEST_F(OneNode, UnstickingMidStepCatchesUpTheSlipItMissed) {
   update(3.0, 10.0);  // load ratio 0.75
-  net(5.0, 10.0);  // load ratio 1.25: crossed µ_s·N halfway through the step
+  net(5.0, 10.0);     // load ratio 1.25: crossed µ_s·N halfway through the step
   const double dt = 1e-3, mass = 2.0;
   ASSERT_TRUE(contact_.updateStates(u_, v_, dt, mass));
   EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), 0.5);
@@ -215,8 +215,7 @@ TEST_F(OneWeakeningNode, TheCatchUpSlipWeakensFriction) {
   u_[0] += step_slip;
   v_[0] += 1e-6;  // still sliding forwards
   contact_.finishStep(u_, v_, dt);
-  EXPECT_DOUBLE_EQ(net(5.0, 10.0),
-                   5.0 - (kMuS - (kMuS - kMuK) * (catch_up + step_slip) / kWeakeningLength) * 10.0);
+  EXPECT_DOUBLE_EQ(net(5.0, 10.0), 5.0 - (kMuS - (kMuS - kMuK) * (catch_up + step_slip) / kWeakeningLength) * 10.0);
 }
 
 /// µ(δ) = µ_s − (µ_s − µ_k)·min(δ/ξ_µ, 1) (MODEL.md §4).
@@ -237,7 +236,7 @@ TEST_P(OneWeakeningNodeBothWays, StaysStuckUpToStaticFrictionThenWeakensOverTheS
   const double sign = GetParam(), xi = kWeakeningLength;
   EXPECT_FALSE(update(sign * 4.0, 10.0));  // µ_s·N holds
   EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -sign * 4.0);
-  EXPECT_TRUE(update(sign * 4.1, 10.0));   // beyond it: slides, unweakened at first
+  EXPECT_TRUE(update(sign * 4.1, 10.0));  // beyond it: slides, unweakened at first
   EXPECT_DOUBLE_EQ(net(sign * 4.1, 10.0), sign * (4.1 - kMuS * 10.0));
   slide(sign * 0.25 * xi);  // the step right after unsticking: weakens, cannot re-stick
   EXPECT_DOUBLE_EQ(net(sign * 4.1, 10.0), sign * (4.1 - weakened(0.25 * xi) * 10.0));
@@ -389,7 +388,7 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
     force = raw.force;
     contact.applyFriction(raw, u, inverse_mass, force);
   };
-  u[0] = 3e-3;  // anchor spring force −3 N, within µ_s·N = 4 N
+  u[0] = 3e-3;         // anchor spring force −3 N, within µ_s·N = 4 N
   applyFriction(0.5);  // a 2 kg block
   EXPECT_DOUBLE_EQ(contact.frictionForce(0), -3.0);
   EXPECT_DOUBLE_EQ(force[0], (2.0 - 3.0) * 0.5);  // the block's acceleration, m/s²

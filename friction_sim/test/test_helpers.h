@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/solvers/integrator.h"
 #include "friction_sim/model/model.h"
 #include "friction_sim/scene/scene.h"
 #include "friction_sim/scene/scene_io.h"
+#include "friction_sim/solvers/integrator.h"
 
 namespace friction::testing {
 
@@ -78,7 +78,11 @@ class FreeBody : public Dynamics {
 class RecordingHooks : public StripHooks {
  public:
   RecordingHooks(Vector& u, const Vector& shift, const Vector& force)
-      : u_(u), shift_(shift), force_(force), prepared_(u.size(), 0), finished_(u.size(), 0),
+      : u_(u),
+        shift_(shift),
+        force_(force),
+        prepared_(u.size(), 0),
+        finished_(u.size(), 0),
         forces_at_finish_(Vector::Constant(u.size(), std::nan(""))),
         normal_forces_at_finish_(Vector::Constant(u.size(), std::nan(""))) {}
   /// Also kicks `v` by `kick` when a dof is finished, as the closing kick does: a force that read a
@@ -106,7 +110,8 @@ class RecordingHooks : public StripHooks {
       forces_at_finish_[i] = force_[i];
       if (v_) (*v_)[i] += (*kick_)[i];
       const int node = i - first_interface_dof_;
-      if (normal_force_ && node >= 0 && node < normal_force_->size()) normal_forces_at_finish_[i] = (*normal_force_)[node];
+      if (normal_force_ && node >= 0 && node < normal_force_->size())
+        normal_forces_at_finish_[i] = (*normal_force_)[node];
     }
   }
   bool eachOnce() const {

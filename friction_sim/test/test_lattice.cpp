@@ -7,10 +7,10 @@
 #include <cmath>
 #include <map>
 
-#include "friction_sim/solvers/integrator.h"
+#include "friction_sim/instruments/slip_events.h"
 #include "friction_sim/model/lattice_2d.h"
 #include "friction_sim/run/simulation.h"
-#include "friction_sim/instruments/slip_events.h"
+#include "friction_sim/solvers/integrator.h"
 #include "test_helpers.h"
 
 namespace friction {
@@ -78,8 +78,12 @@ TEST(LatticeElasticity, UniaxialTensionGivesYoungsModulusAndPoissonRatioOneThird
 
   const int ic = nx / 2, jc = nz / 2, span = 5;
   const double l = lattice.spacing();
-  const double strain_xx = (u[lattice.xDof(lattice.nodeIndex(ic + span, jc))] - u[lattice.xDof(lattice.nodeIndex(ic - span, jc))]) / (2 * span * l);
-  const double strain_zz = (u[lattice.zDof(lattice.nodeIndex(ic, jc + span))] - u[lattice.zDof(lattice.nodeIndex(ic, jc - span))]) / (2 * span * l);
+  const double strain_xx =
+      (u[lattice.xDof(lattice.nodeIndex(ic + span, jc))] - u[lattice.xDof(lattice.nodeIndex(ic - span, jc))]) /
+      (2 * span * l);
+  const double strain_zz =
+      (u[lattice.zDof(lattice.nodeIndex(ic, jc + span))] - u[lattice.zDof(lattice.nodeIndex(ic, jc - span))]) /
+      (2 * span * l);
   const auto stress = lattice.cellStress(u, ic, jc);
   const double youngs = stress[0] / strain_xx;
   EXPECT_NEAR(youngs, scene.material.youngs_modulus, 0.01 * scene.material.youngs_modulus);
@@ -157,7 +161,7 @@ TEST(LatticeWaves, PAndSWaveSpeedsFromArrivalTimes) {
 }
 
 TEST(LatticePusher, PushesTheRowNearestItsHeightOrItsBandAndSaysWhere) {
-  Scene scene;  // pmma_2d: rows 2.5 mm apart
+  Scene scene;                  // pmma_2d: rows 2.5 mm apart
   scene.pusher.height = 0.006;  // 2.4 spacings: row 2, at 5 mm
   const Lattice2D single_row(scene);
   EXPECT_EQ(single_row.pushedRows(), std::vector<int>{2});

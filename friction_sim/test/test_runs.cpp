@@ -179,7 +179,8 @@ TEST_P(SideDrivenChainUnderNonUniformLoad, ArrestFrontsFollowTheForceBalanceWith
   ASSERT_GE(front.shear_ratio.size(), 8u);
   std::vector<double> phi;
   for (std::size_t i = 0; i < front.shear_ratio.size(); ++i) {
-    const double theta = load.tilt + 6.0 * load.torque_share * load.height * front.shear_ratio[i] / scene.geometry.length;
+    const double theta =
+        load.tilt + 6.0 * load.torque_share * load.height * front.shear_ratio[i] / scene.geometry.length;
     const double lambda = front.length_ratio[i];
     phi.push_back(lambda * (1.0 + theta * (lambda - 1.0)));
   }
@@ -218,7 +219,8 @@ TEST(EnergyBudget, HasNoRelativeResidualWhereNoEnergyChangedHands) {
   EXPECT_TRUE(std::isnan(simulation.energy().relativeResidual())) << simulation.energy().relativeResidual();
   std::ostringstream summary;
   printSummary(summary, summarize(simulation, 0.0));
-  EXPECT_NE(summary.str().find("residual (relative): nan (no energy changed hands"), std::string::npos) << summary.str();
+  EXPECT_NE(summary.str().find("residual (relative): nan (no energy changed hands"), std::string::npos)
+      << summary.str();
 }
 
 TEST(SlipWeakening, EnergyBudgetClosesToRoundOffForASingleBlockAndClosely2D) {
@@ -323,7 +325,8 @@ TEST(SliderRun, AnInterfaceFreeWhileLoadingStoresNoShearAndSpreadsByPoisson) {
   }
   EXPECT_NEAR(simulation.loadCells().interface_normal_sum, scene.load.normal_force, 1e-9 * scene.load.normal_force);
   const double poisson_ratio = 1.0 / 3.0;
-  const double continuum = poisson_ratio * scene.load.normal_force / (scene.material.youngs_modulus * scene.geometry.width);
+  const double continuum =
+      poisson_ratio * scene.load.normal_force / (scene.material.youngs_modulus * scene.geometry.width);
   // Measured: 8.0 % short at 57 × 31, 4.6 % at 113 × 61 (the free side edges' layer of the lattice).
   const double coarse_error = interfaceSpread(simulation) / continuum - 1.0;
   EXPECT_NEAR(coarse_error, -0.080, 0.005);
@@ -408,8 +411,7 @@ TEST(Determinism, AStopConditionSetDuringTheRunEndsItOnTheSameStepAsTheScenes) {
     return text.str();
   };
   EXPECT_NE(past.find("allowed: > " + streamed(changed.time()) + " s, the time now"), std::string::npos) << past;
-  EXPECT_NE(past.find("allowed: > " + streamed(changed.stage().travel()) + " m, the travel now"),
-            std::string::npos)
+  EXPECT_NE(past.find("allowed: > " + streamed(changed.stage().travel()) + " m, the travel now"), std::string::npos)
       << past;
   // No condition at all: the run would never end, and the scene the rig records with it would be refused.
   const double endless = std::numeric_limits<double>::infinity();

@@ -8,9 +8,9 @@
 #include <fstream>
 #include <limits>
 
-#include "friction_sim/solvers/integrator.h"
-#include "friction_sim/scene/scene_io.h"
 #include "friction_sim/run/simulation.h"
+#include "friction_sim/scene/scene_io.h"
+#include "friction_sim/solvers/integrator.h"
 #include "test_helpers.h"
 
 namespace friction {
@@ -118,7 +118,8 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"integrator: {time_step: 1.0e-5}", "integrator.time_step: value 1e-05",
                     "stability limit of this scene"},
         InvalidCase{"model: chain_1d\nchain: {tilt: -1.5}", "normal force of block", "w_i > 0"},
-        InvalidCase{"model: chain_1d\nchain: {torque_share: 1.0}\npusher: {height: 0.075}", "at F_X = 768 N", "w_i > 0"},
+        InvalidCase{"model: chain_1d\nchain: {torque_share: 1.0}\npusher: {height: 0.075}", "at F_X = 768 N",
+                    "w_i > 0"},
         // Holds while the stage pushes; the trailing-edge-heavy tilt lifts the leading block once it pulls.
         InvalidCase{"model: chain_1d\nchain: {tilt: -0.8, torque_share: 1.0}\npusher: {height: 0.03}",
                     "at F_X = -768 N", "F_X in [-768, 768] N, the stage pushing or pulling"},
@@ -128,7 +129,8 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"frictoin: {law: amontons_coulomb}", "frictoin: unknown key", "allowed keys here"},
         InvalidCase{"friction: {mu_s: 0.4}", "friction.mu_s: unknown key", "static_coefficient"},
         // The first of two would have won without a word (found by a new-user walkthrough).
-        InvalidCase{"geometry:\n  length: 0.14\n  length: 0.2", "geometry.length: given more than once", "give it once"},
+        InvalidCase{"geometry:\n  length: 0.14\n  length: 0.2", "geometry.length: given more than once",
+                    "give it once"},
         InvalidCase{"friction: {law: coulomb}", "friction.law: value 'coulomb'", "amontons_coulomb | slip_weakening"},
         InvalidCase{"lattice: {nodes_x: many}", "lattice.nodes_x: value 'many'", "integer"},
         InvalidCase{"stage: {program: [{mode: velocity, speed: 5.0}]}", "stage.program[0].speed: value 5",

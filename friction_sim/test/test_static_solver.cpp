@@ -10,7 +10,9 @@
 namespace friction {
 namespace {
 
-std::unique_ptr<Model> pmmaLattice(int nodes_x, int nodes_z) { return buildModel(testing::pmmaScene(nodes_x, nodes_z)); }
+std::unique_ptr<Model> pmmaLattice(int nodes_x, int nodes_z) {
+  return buildModel(testing::pmmaScene(nodes_x, nodes_z));
+}
 
 /// The loading step: F_Z applied with the interface held along x and the pusher off.
 Vector loadedState(Model& model, StaticMethod method) {

@@ -166,9 +166,12 @@ void expectSuccessiveSweepsGiveSuccessiveEvaluations(const Model& model, const V
     Vector u_over = u, v_over = v, a_over = a;
     ForceEvaluation over;
     VerletPasses passes(u_over, v_over, a_over, dt);
-    EXPECT_THROW(model.evaluateSuccessiveInStrips(strip_nodes, [&](int) -> std::optional<StripEvaluation> {
-      return StripEvaluation{u_over, v_over, stage(0), a_over, over, passes};
-    }), std::logic_error);
+    EXPECT_THROW(model.evaluateSuccessiveInStrips(strip_nodes,
+                                                  [&](int) -> std::optional<StripEvaluation> {
+                                                    return StripEvaluation{u_over, v_over, stage(0),
+                                                                           a_over, over,   passes};
+                                                  }),
+                 std::logic_error);
   }
 }
 

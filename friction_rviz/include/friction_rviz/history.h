@@ -16,7 +16,10 @@ class SeriesHistory {
   explicit SeriesHistory(std::size_t capacity) : capacity_(capacity) {}
   /// Adds a sample; returns true if time jumped back and the history was cleared first.
   bool add(double time, double value);
-  void clear() { times_.clear(); values_.clear(); }
+  void clear() {
+    times_.clear();
+    values_.clear();
+  }
   const std::deque<double>& times() const { return times_; }
   const std::deque<double>& values() const { return values_; }
 
@@ -57,8 +60,8 @@ class PrecursorScatter {
 
 /// A slip event as the space–time strip outlines it.
 struct StripEvent {
-  std::size_t first_row = 0;  ///< absolute index of the row where it started
-  std::size_t last_row = 0;   ///< absolute index of the row where it ended (or the newest row)
+  std::size_t first_row = 0;        ///< absolute index of the row where it started
+  std::size_t last_row = 0;         ///< absolute index of the row where it ended (or the newest row)
   double x_min = 0.0, x_max = 0.0;  ///< m, slipped range
   bool ended = false;
 };

@@ -2,8 +2,8 @@
 
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
-#include "friction_sim/scene/scene_io.h"
 #include "friction_sim/scene/config_error.h"
+#include "friction_sim/scene/scene_io.h"
 
 namespace friction {
 
@@ -82,8 +82,8 @@ void PrecursorDetector::onScene(const std_msgs::String::ConstPtr& msg) {
   // A new detector otherwise: what the old one saw was measured against another scene, or none. The
   // scene is its bag's first message, but it travels apart from the frames, which may come first.
   if (frames_seen_ > 0) {
-    ROS_WARN_STREAM("precursor detector: the run's scene came after " << frames_seen_
-                                                                      << " interface frames; starting over without them");
+    ROS_WARN_STREAM("precursor detector: the run's scene came after "
+                    << frames_seen_ << " interface frames; starting over without them");
   }
   frames_seen_ = 0;
   use(settings);
@@ -124,10 +124,9 @@ void PrecursorDetector::publishCompleted(bool no_more_readings) {
     const double length = detector_->sliderLength();
     events_pub_.publish(toMsg(event, positions_, length, settings_.wave_speeds, frame_id_));
     points_pub_.publish(toPointMsg(event, length, frame_id_));
-    ROS_INFO_STREAM("precursor detector: event " << event.index << " F_X/F_Z = "
-                                                 << event.onset_shear_force / event.onset_normal_force
-                                                 << ", L_p/L = " << event.rupture_length / length
-                                                 << (event.global ? " (global)" : ""));
+    ROS_INFO_STREAM("precursor detector: event "
+                    << event.index << " F_X/F_Z = " << event.onset_shear_force / event.onset_normal_force
+                    << ", L_p/L = " << event.rupture_length / length << (event.global ? " (global)" : ""));
   }
 }
 

@@ -1,8 +1,8 @@
 #include "friction_sim/ros/rig_simulator.h"
 
-#include <boost/make_shared.hpp>
 #include <rosgraph_msgs/Clock.h>
 #include <std_msgs/String.h>
+#include <boost/make_shared.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -10,8 +10,8 @@
 #include <limits>
 #include <sstream>
 
-#include "friction_sim/ros/node_parameters.h"
 #include "friction_sim/instruments/results_io.h"
+#include "friction_sim/ros/node_parameters.h"
 #include "friction_sim/scene/scene_io.h"
 
 namespace friction {
@@ -27,10 +27,10 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   require(std::isfinite(o.real_time_factor) && o.real_time_factor >= 0.0, "real_time_factor", o.real_time_factor,
           ">= 0 (0 = as fast as possible)");
   const std::pair<const char*, double> rates[] = {
-      {"load_cell_rate", o.load_cell_rate},   {"gauge_rate", o.gauge_rate},
-      {"interface_rate", o.interface_rate},   {"interface_idle_rate", o.interface_idle_rate},
+      {"load_cell_rate", o.load_cell_rate},     {"gauge_rate", o.gauge_rate},
+      {"interface_rate", o.interface_rate},     {"interface_idle_rate", o.interface_idle_rate},
       {"stage_state_rate", o.stage_state_rate}, {"clock_rate", o.clock_rate},
-      {"lattice_rate", o.lattice_rate}, {"snapshot_rate", o.snapshot_rate}};
+      {"lattice_rate", o.lattice_rate},         {"snapshot_rate", o.snapshot_rate}};
   for (const auto& [name, rate] : rates) require(std::isfinite(rate) && rate > 0.0, name, rate, "a rate > 0 Hz");
   if (o.frame_id.empty()) problems.push_back("~frame_id: empty; allowed: a frame name such as 'slider'");
   parseOverrides(o.overrides, problems);
@@ -98,9 +98,8 @@ void RigSimulator::startSimulation() {
   // Paced, a watcher sees the slider move, and a command sent "now" acts within a frame.
   run.cut_jumps_at_frames = options_.real_time_factor > 0.0;
   driver_ = std::make_unique<RunDriver>(scene_, stability_limit_, run);
-  driver_->onCommandDue([this](const TimedCommand& command, const std::string& refusal) {
-    publishAppliedCommand(command, refusal);
-  });
+  driver_->onCommandDue(
+      [this](const TimedCommand& command, const std::string& refusal) { publishAppliedCommand(command, refusal); });
   addStreams(*driver_);
   interface_positions_ = simulation().model().interfacePositions();
   next_snapshot_ = ros::WallTime::now();
@@ -125,11 +124,13 @@ void RigSimulator::addStreams(RunDriver& driver) {
         o.gauge_rate, Sampling::AtSteps, [](const Simulation& s) { return s.gaugeProfile(); },
         [this](const GaugeProfile& gauges) { emit(gauges_pub_, "strain_gauges", toMsg(gauges, options_.frame_id)); }));
   }
-  driver.add(std::make_unique<CameraStream>(o.interface_rate, o.interface_idle_rate, [this](const InterfaceFrame& shot) {
-    emit(interface_pub_, "interface", toMsg(shot, frame_index_++, options_.frame_id));
-  }));
+  driver.add(
+      std::make_unique<CameraStream>(o.interface_rate, o.interface_idle_rate, [this](const InterfaceFrame& shot) {
+        emit(interface_pub_, "interface", toMsg(shot, frame_index_++, options_.frame_id));
+      }));
   driver.add(std::make_unique<EventStream>(nullptr, [this](const Simulation&, const SlipEvent& event) {
-    emit(events_pub_, "slip_events", toMsg(event, interface_positions_, scene_.geometry.length, wave_speeds_, options_.frame_id));
+    emit(events_pub_, "slip_events",
+         toMsg(event, interface_positions_, scene_.geometry.length, wave_speeds_, options_.frame_id));
   }));
   driver.add(std::make_unique<SampledStream<StageStateReading>>(
       o.stage_state_rate, Sampling::AtSteps, stageState,
@@ -186,7 +187,8 @@ void RigSimulator::emit(ros::Publisher& publisher, const std::string& topic, con
   publisher.publish(msg);
   // Before the first step (t = 0, e.g. the stage state while waiting paused) nothing was measured, and
   // a bag cannot hold a zero stamp.
-  if (bag_open_ && !msg.header.stamp.isZero()) bag_.write(publisher.getTopic().empty() ? topic : publisher.getTopic(), msg.header.stamp, msg);
+  if (bag_open_ && !msg.header.stamp.isZero())
+    bag_.write(publisher.getTopic().empty() ? topic : publisher.getTopic(), msg.header.stamp, msg);
 }
 
 void RigSimulator::publishClock(double time) {
@@ -218,7 +220,8 @@ void RigSimulator::publishStageState(const StageStateReading& reading) {
 
 void RigSimulator::publishLiveSnapshot() {
   // Live viewers also get snapshots at a visual rate; the bag keeps the simulated-time grid.
-  if (lattice_stream_->sampledLast() || ros::WallTime::now() < next_snapshot_ || lattice_pub_.getNumSubscribers() == 0) {
+  if (lattice_stream_->sampledLast() || ros::WallTime::now() < next_snapshot_ ||
+      lattice_pub_.getNumSubscribers() == 0) {
     return;
   }
   lattice_pub_.publish(toMsg(simulation().snapshot(), options_.frame_id));
@@ -303,7 +306,8 @@ bool RigSimulator::onAbort(std_srvs::Trigger::Request& request, std_srvs::Trigge
   return onStop(request, response);
 }
 
-bool RigSimulator::onSetRunEnd(friction_msgs::SetRunEnd::Request& request, friction_msgs::SetRunEnd::Response& response) {
+bool RigSimulator::onSetRunEnd(friction_msgs::SetRunEnd::Request& request,
+                               friction_msgs::SetRunEnd::Response& response) {
   StopSpec end;
   // Beyond int's range a count is never reached anyway.
   end.global_events = static_cast<int>(std::min<std::uint32_t>(request.global_events, std::numeric_limits<int>::max()));
@@ -342,7 +346,7 @@ void RigSimulator::run() {
       continue;
     }
     if (paused_) {
-      publishStageState();  // so that a controller learns the time and F_Z while the rig waits
+      publishStageState();                // so that a controller learns the time and F_Z while the rig waits
       publishClock(simulation().time());  // nodes on simulated time, and `rostopic echo /clock`, see it stand still
       if (lattice_pub_.getNumSubscribers() > 0) lattice_pub_.publish(toMsg(simulation().snapshot(), options_.frame_id));
       ros::WallDuration(0.05).sleep();
@@ -359,9 +363,10 @@ void RigSimulator::run() {
   }
   if (end_reason.empty()) {
     std::ostringstream reason;
-    reason << (aborted_ ? "aborted by the abort service"
-               : stop_  ? "stopped by the stop service"
-               : g_stop_requested ? "interrupted by a signal" : "ROS shut down")
+    reason << (aborted_           ? "aborted by the abort service"
+               : stop_            ? "stopped by the stop service"
+               : g_stop_requested ? "interrupted by a signal"
+                                  : "ROS shut down")
            << " at t = " << simulation().time() << " s";
     end_reason = reason.str();
   }

@@ -16,7 +16,8 @@ namespace friction {
 
 std::vector<std::string> validateControllerOptions(const ControllerOptions& options) {
   std::vector<std::string> problems;
-  if (options.protocol_path.empty()) problems.push_back("~protocol: no value; allowed: the path of a protocol YAML file");
+  if (options.protocol_path.empty())
+    problems.push_back("~protocol: no value; allowed: the path of a protocol YAML file");
   requireSetting(std::isfinite(options.start_delay) && options.start_delay >= 0.0, "~start_delay", options.start_delay,
                  ">= 0 s", problems);
   return problems;
@@ -121,9 +122,9 @@ void StageController::onStageState(const friction_msgs::StageState::ConstPtr& ms
   if (failed_) return;
   if (ended_ || !protocolEnded(protocol_.end, msg->global_events, msg->travel, time - start_time_)) return;
   ended_ = true;
-  ROS_INFO_STREAM("stage controller: protocol ended at t = " << time << " s after " << msg->global_events
-                                                             << " global events"
-                                                             << (simulator_ends_run_ ? "" : "; stopping the simulator"));
+  ROS_INFO_STREAM("stage controller: protocol ended at t = "
+                  << time << " s after " << msg->global_events << " global events"
+                  << (simulator_ends_run_ ? "" : "; stopping the simulator"));
   if (!simulator_ends_run_) endSimulatorRun(nh_, "stop", ros::WallDuration(5.0));
   ros::shutdown();
 }

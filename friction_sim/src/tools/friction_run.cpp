@@ -15,7 +15,8 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]... [--commands COMMANDS.csv | --protocol PROTOCOL.yaml]";
+    "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]... [--commands COMMANDS.csv | --protocol "
+    "PROTOCOL.yaml]";
 
 /// Exit statuses: a command line that cannot be read, a scene, command table or protocol refused (ConfigError),
 /// and an output directory that cannot be written.
@@ -34,7 +35,8 @@ int refuseCommandLine(const std::string& problem) {
 }
 
 int help() {
-  std::cout << kUsage << "\n\n"
+  std::cout << kUsage
+            << "\n\n"
                "Runs a scene offline to its stop condition and writes, in DIR (default results/<scene name>):\n"
                "  events.csv       one row per slip event (onset, F_X, F_Z, extent, L_p, front speeds)\n"
                "  event_nodes.csv  per event and interface node: slip, first-unstick time, front speed\n"
@@ -130,8 +132,8 @@ void addStreams(friction::RunDriver& driver, std::vector<friction::LoadCellReadi
         friction::writeStressRows(stresses_csv, event.index, "end", s.interfaceFrame(), s.gaugeProfile());
         std::cout << "event " << event.index << " at t = " << event.onset_time
                   << " s: F_X/F_Z = " << event.onset_shear_force / event.onset_normal_force
-                  << ", L_p/L = " << event.rupture_length / s.scene().geometry.length << (event.global ? " (global)" : "")
-                  << std::endl;
+                  << ", L_p/L = " << event.rupture_length / s.scene().geometry.length
+                  << (event.global ? " (global)" : "") << std::endl;
       }));
 }
 

@@ -42,8 +42,8 @@ class ContactInterface {
   /// accelerations (m/s²): (force + friction)·`inverse_mass`. The other entries are left to the caller.
   /// Nodes are independent here, so a caller may go range by range. `raw.normal_force` must stay
   /// unchanged until the next evaluation (see lendNormalStorage).
-  void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
-                     int first_node, int end_node);
+  void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force, int first_node,
+                     int end_node);
   /// The same for every interface node.
   void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force) {
     applyFriction(raw, u, inverse_mass, force, 0, size());
@@ -147,8 +147,8 @@ class ContactInterface {
   /// force but friction) as the other forces and `normal` (N, indexed by node, all nodes) as the latest
   /// normal forces; computes the friction in the current slot from them, and overwrites those entries
   /// with accelerations (m/s²), (other force + friction)·`inverse_mass`.
-  void accelerateWithFriction(const double* u, const double* normal, double inverse_mass,
-                              double* force_to_acceleration, int first_node, int end_node);
+  void accelerateWithFriction(const double* u, const double* normal, double inverse_mass, double* force_to_acceleration,
+                              int first_node, int end_node);
 
   std::unique_ptr<FrictionLaw> law_;
   bool uniform_law_;  ///< law_->uniform(), asked once
@@ -163,7 +163,7 @@ class ContactInterface {
   // ±1 if sliding, 0 if detached (one array rather than a stuck weight and a sign: the loop is bound by
   // memory traffic); the law's µ_s and current sliding µ.
   std::vector<double> friction_mode_, static_coefficient_, sliding_coefficient_;
-  std::vector<double> anchor_;       ///< m, where a stuck node is held
+  std::vector<double> anchor_;  ///< m, where a stuck node is held
   // Friction (N) of every node in two slots: the friction passes write the current one; the other keeps
   // it as it was at the last state update, when the next update needs it to interpolate a threshold
   // crossing. A stuck node's load is its friction against µ_s·N.
@@ -178,9 +178,9 @@ class ContactInterface {
   /// Whether a state update happened since the last lendNormalStorage: the update's normal forces are
   /// then still in the evaluation's storage, and the next one must not overwrite them in place.
   bool normals_to_take_ = false;
-  std::vector<double> other_force_;  ///< N, tangential force on the node from everything but friction
-  std::vector<double> slip_origin_;  ///< m
-  std::vector<char> just_unstuck_;  ///< 1 for the nodes in unstuck_last_step_, else 0
+  std::vector<double> other_force_;   ///< N, tangential force on the node from everything but friction
+  std::vector<double> slip_origin_;   ///< m
+  std::vector<char> just_unstuck_;    ///< 1 for the nodes in unstuck_last_step_, else 0
   std::vector<char> landed_sliding_;  ///< 1 for those of them that landed moving, else 0
   std::vector<int> unstuck_last_step_, restuck_last_step_;
   std::vector<double> transition_fraction_;

@@ -51,7 +51,7 @@ class FrameEventDetector {
   bool in_event_ = false;
   SlipEvent current_;
   ContactDuringEvent in_contact_;  ///< of the current event
-  std::deque<SlipEvent> ended_;  ///< waiting for their load cells
+  std::deque<SlipEvent> ended_;    ///< waiting for their load cells
 };
 
 }  // namespace friction

@@ -46,12 +46,12 @@ StageStateReading interpolate(const StageStateReading& a, const StageStateReadin
 
 /// The fast camera's frame: the interface's state per node.
 struct InterfaceFrame {
-  double time = 0.0;               ///< s
-  std::vector<double> position;    ///< m, rest x of each interface node
-  std::vector<std::uint8_t> state;  ///< 0 stuck, 1 sliding, 2 detached (contact lost)
-  std::vector<double> slip_velocity;  ///< m/s, dx/dt
-  std::vector<double> slip;           ///< m, accumulated since the run started
-  std::vector<double> normal_force;   ///< N, N_i
+  double time = 0.0;                   ///< s
+  std::vector<double> position;        ///< m, rest x of each interface node
+  std::vector<std::uint8_t> state;     ///< 0 stuck, 1 sliding, 2 detached (contact lost)
+  std::vector<double> slip_velocity;   ///< m/s, dx/dt
+  std::vector<double> slip;            ///< m, accumulated since the run started
+  std::vector<double> normal_force;    ///< N, N_i
   std::vector<double> friction_force;  ///< N, f_i, x force of the track on the slider
   std::vector<double> normal_stress;   ///< Pa, σ_i = N_i/(l·B), positive in compression
   std::vector<double> shear_stress;    ///< Pa, τ_i = −f_i/(l·B), positive when resisting a push in +x
@@ -59,24 +59,24 @@ struct InterfaceFrame {
 
 /// Strain gauges at height z_g: stress tensor components (tension positive).
 struct GaugeProfile {
-  double time = 0.0;              ///< s
-  double height = 0.0;            ///< m, z_g
-  std::vector<double> position;   ///< m, x of each gauge
+  double time = 0.0;             ///< s
+  double height = 0.0;           ///< m, z_g
+  std::vector<double> position;  ///< m, x of each gauge
   GaugeStresses stress;
 };
 
 /// The slider's nodes at one instant, for visualisation.
 struct LatticeSnapshot {
-  double time = 0.0;                      ///< s
-  int nodes_x = 0, nodes_z = 0;           ///< grid shape (the chain: N × 1)
-  double spacing = 0.0;                   ///< m, rest spacing
-  std::vector<double> x, z;               ///< m, current node positions
-  std::vector<double> speed;              ///< m/s
-  GaugeStresses stress;                   ///< Pa, per node
+  double time = 0.0;                          ///< s
+  int nodes_x = 0, nodes_z = 0;               ///< grid shape (the chain: N × 1)
+  double spacing = 0.0;                       ///< m, rest spacing
+  std::vector<double> x, z;                   ///< m, current node positions
+  std::vector<double> speed;                  ///< m/s
+  GaugeStresses stress;                       ///< Pa, per node
   std::vector<std::uint8_t> interface_state;  ///< per interface node, as in InterfaceFrame
-  double stage_position = 0.0;            ///< m
-  double pusher_height = 0.0;             ///< m, Model::pushingHeight
-  double normal_force = 0.0;              ///< N
+  double stage_position = 0.0;                ///< m
+  double pusher_height = 0.0;                 ///< m, Model::pushingHeight
+  double normal_force = 0.0;                  ///< N
 };
 
 /// Strain gauges at time t between two profiles at the same positions, linearly.

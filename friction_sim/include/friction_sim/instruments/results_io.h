@@ -7,34 +7,35 @@
 #include <vector>
 
 #include "friction_sim/instruments/instruments.h"
-#include "friction_sim/run/simulation.h"
 #include "friction_sim/instruments/slip_events.h"
+#include "friction_sim/run/simulation.h"
 
 namespace friction {
 
 struct PrecursorPoint {
-  double shear_ratio = 0.0;    ///< F_X/F_Z at onset
-  double length_ratio = 0.0;   ///< L_p/L
+  double shear_ratio = 0.0;   ///< F_X/F_Z at onset
+  double length_ratio = 0.0;  ///< L_p/L
 };
 
 struct RunSummary {
-  std::string scene_name;  ///< the scene's name
+  std::string scene_name;   ///< the scene's name
   std::string stop_reason;  ///< which stop condition ended the run, or why it was cut short
   int events = 0;           ///< slip events that ended
-  int precursors = 0;   ///< non-global events before the first global one, back-slips not counted
-  int back_slips = 0;   ///< events before the first global one in which the interface slid back (SlipEvent::backSlip)
+  int precursors = 0;       ///< non-global events before the first global one, back-slips not counted
+  int back_slips = 0;  ///< events before the first global one in which the interface slid back (SlipEvent::backSlip)
   int single_node_precursors = 0;  ///< of those, events in which one node alone slipped (L_p = 0): no front ran
   std::vector<PrecursorPoint> precursor_points;
   /// µ_s,macro = F_X/F_Z at the first global event, at its peak (SlipEvent::peak_shear_force; NaN if none)
   double static_friction_macro = 0.0;
   /// µ_k,macro = mean F_X / mean F_Z over the first global event, from onset to end (NaN if none)
   double kinetic_friction_macro = 0.0;
-  double simulated_time = 0.0;         ///< s
-  long long steps = 0;                 ///< time steps integrated (a fast-forward jump counts as none)
-  double wall_time = 0.0;              ///< s
-  double relative_energy_residual = 0.0;  ///< work in − (Δelastic + kinetic + dissipated), over the budget's largest term
-  double time_step = 0.0;              ///< s
-  double stability_limit = 0.0;        ///< s
+  double simulated_time = 0.0;  ///< s
+  long long steps = 0;          ///< time steps integrated (a fast-forward jump counts as none)
+  double wall_time = 0.0;       ///< s
+  double relative_energy_residual =
+      0.0;                       ///< work in − (Δelastic + kinetic + dissipated), over the budget's largest term
+  double time_step = 0.0;        ///< s
+  double stability_limit = 0.0;  ///< s
 };
 
 RunSummary summarize(const Simulation& simulation, double wall_time);

@@ -13,9 +13,9 @@
 namespace friction {
 
 struct SlipEvent {
-  int index = 0;                 ///< 0-based order of the event in the run
-  double onset_time = 0.0;       ///< s, first threshold crossing, interpolated within the step
-  double end_time = 0.0;         ///< s, last re-stick, interpolated within the step
+  int index = 0;                    ///< 0-based order of the event in the run
+  double onset_time = 0.0;          ///< s, first threshold crossing, interpolated within the step
+  double end_time = 0.0;            ///< s, last re-stick, interpolated within the step
   double onset_shear_force = 0.0;   ///< N, F_X at onset (interpolated within the step)
   double onset_normal_force = 0.0;  ///< N, F_Z at onset
   double end_shear_force = 0.0;     ///< N, F_X at the end (interpolated within the step)
@@ -32,19 +32,19 @@ struct SlipEvent {
   /// the interface's mean friction during the event (exactly so for the chain, whose blocks stand still
   /// when stuck: µ_k·N for a single block; nearly so for the lattice, whose bulk may still ring).
   double mean_shear_force = 0.0;
-  double mean_normal_force = 0.0;   ///< N
+  double mean_normal_force = 0.0;  ///< N
   /// mean F_X / mean F_Z (µ_k,macro over a global event)
   double meanShearRatio() const { return mean_shear_force / mean_normal_force; }
-  double nucleation_position = 0.0;  ///< m, mean x of the nodes that unstuck first
-  double slip_min_x = 0.0;          ///< m, smallest x of a node that slipped
-  double slip_max_x = 0.0;          ///< m, largest x of a node that slipped
-  double rupture_length = 0.0;      ///< m, L_p = slip_max_x − slip_min_x (L for one node: measureExtent)
-  bool global = false;              ///< every interface node in contact with the track slipped (measureExtent)
-  std::vector<double> node_slip;    ///< m, per interface node, displacement during the event
+  double nucleation_position = 0.0;        ///< m, mean x of the nodes that unstuck first
+  double slip_min_x = 0.0;                 ///< m, smallest x of a node that slipped
+  double slip_max_x = 0.0;                 ///< m, largest x of a node that slipped
+  double rupture_length = 0.0;             ///< m, L_p = slip_max_x − slip_min_x (L for one node: measureExtent)
+  bool global = false;                     ///< every interface node in contact with the track slipped (measureExtent)
+  std::vector<double> node_slip;           ///< m, per interface node, displacement during the event
   std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
-  std::vector<double> front_speed;  ///< m/s, v_c per node from the first-unstick times; NaN where undefined
+  std::vector<double> front_speed;         ///< m/s, v_c per node from the first-unstick times; NaN where undefined
   double median_front_speed = std::numeric_limits<double>::quiet_NaN();  ///< m/s, summarizeFrontSpeeds; NaN: none
-  int front_fits_left_out = 0;      ///< fits left out of that median (summarizeFrontSpeeds)
+  int front_fits_left_out = 0;  ///< fits left out of that median (summarizeFrontSpeeds)
   /// m, mean slip of the nodes that slipped (NaN if none did); negative for a back-slip.
   double meanSlip() const;
   /// The interface slid back, against x (meanSlip() < 0), as where the stage draws back and the shear
@@ -95,8 +95,7 @@ class SlipEventDetector {
   };
   /// Call after every step (from step_start to step_start + dt) with the interface's new states.
   /// Returns true when an event has just ended (then `events().back()` is it).
-  bool update(double step_start, double dt, const ContactInterface& contact, const Vector& u,
-              const StepLoads& loads);
+  bool update(double step_start, double dt, const ContactInterface& contact, const Vector& u, const StepLoads& loads);
   bool inEvent() const { return in_event_; }
   const std::vector<SlipEvent>& events() const { return events_; }
   int globalEventCount() const { return global_count_; }
@@ -112,10 +111,10 @@ class SlipEventDetector {
   bool in_event_ = false;
   SlipEvent current_;
   void notePeak(double shear_force);
-  std::size_t slipped_ = 0;      ///< nodes of the current event that have slipped so far
+  std::size_t slipped_ = 0;        ///< nodes of the current event that have slipped so far
   ContactDuringEvent in_contact_;  ///< of the current event
-  double shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the current event so far
-  double normal_impulse_ = 0.0;  ///< N·s, ∫F_Z dt
+  double shear_impulse_ = 0.0;     ///< N·s, ∫F_X dt of the current event so far
+  double normal_impulse_ = 0.0;    ///< N·s, ∫F_Z dt
   std::vector<double> onset_u_;
   std::vector<SlipEvent> events_;
   int global_count_ = 0;
@@ -133,8 +132,8 @@ FitWindow frontFitWindow(int fit_nodes);
 /// m/s, front speed per node from first-unstick times t(x) (NaN = not slipped): a linear fit of t against
 /// x over the slipped nodes of the node's frontFitWindow (fewer at the ends and at unslipped gaps);
 /// v_c = 1/|dt/dx| (inf if simultaneous).
-std::vector<double> frontSpeeds(const std::vector<double>& positions,
-                                const std::vector<double>& first_unstick_time, int fit_nodes);
+std::vector<double> frontSpeeds(const std::vector<double>& positions, const std::vector<double>& first_unstick_time,
+                                int fit_nodes);
 
 /// The model's elastic wave speeds, the scale of front speeds (MODEL.md §6).
 struct WaveSpeeds {
@@ -177,6 +176,5 @@ void measureFronts(SlipEvent& event, const std::vector<double>& positions, int f
 /// slider that slides as a whole with its trailing corner lifted does so globally.
 void measureExtent(SlipEvent& event, const std::vector<double>& positions, double slider_length,
                    std::size_t nodes_in_contact);
-
 
 }  // namespace friction

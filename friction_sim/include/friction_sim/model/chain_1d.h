@@ -33,8 +33,8 @@ class Chain1D : public Model {
   /// Strips of `strip_nodes` blocks when driven at the side: F_X, and with it every normal force, is
   /// known once block 0 is prepared. Top driving sums every block's driving force into F_X first, so it
   /// is evaluated in one strip.
-  void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
-                        ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const override;
+  void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force, ForceEvaluation& out,
+                        StripHooks& hooks, int strip_nodes) const override;
   /// normalForces() at the evaluation's F_X.
   Vector signedNormalForces(const Vector& u, const ForceEvaluation& evaluation) const override;
   double elasticEnergy(const Vector& u, double stage_position) const override;
@@ -72,8 +72,8 @@ class Chain1D : public Model {
   }
   void evaluateTopDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
                          ForceEvaluation& out) const;
-  void evaluateSideDriven(const Vector& u, const Vector& v, double stage_position, Vector& force,
-                          ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const;
+  void evaluateSideDriven(const Vector& u, const Vector& v, double stage_position, Vector& force, ForceEvaluation& out,
+                          StripHooks& hooks, int strip_nodes) const;
   /// w_i (N) of blocks [first, first + count) at the given F_X (N), before clamping at 0, as an Eigen
   /// expression: no allocation for the callers that store it.
   auto normalForceExpression(double shear_force, int first, int count) const;
@@ -91,11 +91,11 @@ class Chain1D : public Model {
   double normal_force_;
   Eigen::ArrayXd xi_;
   double xi_square_sum_;
-  Eigen::ArrayXd tilt_factor_;          ///< 1 + θξ_i per block
+  Eigen::ArrayXd tilt_factor_;  ///< 1 + θξ_i per block
   std::vector<double> initial_shear_;
-  Vector pusher_offset_;                ///< m, u of each block when the pusher was connected
+  Vector pusher_offset_;  ///< m, u of each block when the pusher was connected
   bool pusher_connected_ = true;
-  Eigen::ArrayXd driving_stiffness_;    ///< N/m per block, 0 where the pusher does not act
+  Eigen::ArrayXd driving_stiffness_;  ///< N/m per block, 0 where the pusher does not act
 };
 
 }  // namespace friction

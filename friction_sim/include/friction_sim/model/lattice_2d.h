@@ -22,10 +22,10 @@ class Lattice2D : public Model {
 
   int nodesX() const { return nx_; }
   int nodesZ() const { return nz_; }
-  double spacing() const { return spacing_; }           ///< m, l
-  double springStiffness() const { return k_; }          ///< N/m, k
-  double dampingRate() const { return eta_; }            ///< kg/s, η
-  double foundationStiffness() const { return kf_; }     ///< N/m, k_f
+  double spacing() const { return spacing_; }         ///< m, l
+  double springStiffness() const { return k_; }       ///< N/m, k
+  double dampingRate() const { return eta_; }         ///< kg/s, η
+  double foundationStiffness() const { return kf_; }  ///< N/m, k_f
   int nodeIndex(int i, int j) const { return j * nx_ + i; }
   int xDof(int node) const { return node; }
   int zDof(int node) const { return n_ + node; }
@@ -41,8 +41,8 @@ class Lattice2D : public Model {
   void evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
                     ForceEvaluation& out) const override;
   /// Strips of whole rows; the external forces on a row are added before it is finished.
-  void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
-                        ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const override;
+  void evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force, ForceEvaluation& out,
+                        StripHooks& hooks, int strip_nodes) const override;
   /// Each evaluation sweeps a strip or two behind the one before, through that one's finished rows.
   int evaluateSuccessiveInStrips(int strip_nodes,
                                  const std::function<std::optional<StripEvaluation>(int)>& next) const override;
@@ -67,8 +67,7 @@ class Lattice2D : public Model {
   /// ΔF_Z/(N_x·k_m) would not do: the slider yields under it, and the springs end up carrying a fraction
   /// of the change (in a 29 × 16 slider, 49 N of 580 N asked).
   bool takesNormalLoadChanges() const override { return !mattress_; }
-  GaugeStresses gaugeStresses(const Vector& u, double height,
-                              const std::vector<double>& positions) const override;
+  GaugeStresses gaugeStresses(const Vector& u, double height, const std::vector<double>& positions) const override;
   void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const override;
   std::vector<double> nodeSpeeds(const Vector& v) const override;
   GaugeStresses nodeStresses(const Vector& u) const override;
@@ -110,7 +109,7 @@ class Lattice2D : public Model {
   bool mattress_;
   bool interface_free_while_loading_;
   double mattress_k_, mattress_kx_per_node_;
-  double plate_z_ = 0.0;             ///< m, displacement of the mattress plate
+  double plate_z_ = 0.0;              ///< m, displacement of the mattress plate
   std::vector<double> top_anchor_x_;  ///< m, where the mattress holds each top node in x
   std::vector<int> pushed_rows_;
   double pusher_k_per_row_;

@@ -32,10 +32,10 @@ SparseMatrix assembleSparse(int size, int entries_per_column, Fill&& fill) {
 
 /// What one force evaluation produces; friction is not included.
 struct ForceEvaluation {
-  Vector force;              ///< N, per degree of freedom
-  Vector normal_force;       ///< N, per interface node, ≥ 0 (0 = contact lost)
-  double shear_force = 0.0;  ///< N, F_X, the pusher's load-cell reading
-  double normal_load = 0.0;  ///< N, F_Z, the normal load cell (positive when pressing down)
+  Vector force;                ///< N, per degree of freedom
+  Vector normal_force;         ///< N, per interface node, ≥ 0 (0 = contact lost)
+  double shear_force = 0.0;    ///< N, F_X, the pusher's load-cell reading
+  double normal_load = 0.0;    ///< N, F_Z, the normal load cell (positive when pressing down)
   double viscous_power = 0.0;  ///< W, dissipated by the pair damping at the given velocities
 };
 
@@ -55,11 +55,11 @@ class StripHooks {
 
 /// One force evaluation of Model::evaluateSuccessiveInStrips: the arguments of evaluateInStrips.
 struct StripEvaluation {
-  const Vector& u;         ///< m, displacements
-  const Vector& v;         ///< m/s, velocities
-  double stage_position;   ///< m
-  Vector& force;           ///< N, per degree of freedom (resized)
-  ForceEvaluation& out;    ///< the rest of the evaluation (its own `force` left alone)
+  const Vector& u;        ///< m, displacements
+  const Vector& v;        ///< m/s, velocities
+  double stage_position;  ///< m
+  Vector& force;          ///< N, per degree of freedom (resized)
+  ForceEvaluation& out;   ///< the rest of the evaluation (its own `force` left alone)
   StripHooks& hooks;
 };
 
@@ -153,8 +153,7 @@ class Model {
   virtual bool takesNormalLoadChanges() const { return true; }
 
   /// Strain-gauge stresses at height z (m) above the interface at positions x (m).
-  virtual GaugeStresses gaugeStresses(const Vector& u, double height,
-                                      const std::vector<double>& positions) const = 0;
+  virtual GaugeStresses gaugeStresses(const Vector& u, double height, const std::vector<double>& positions) const = 0;
 
   /// Node positions (rest + displacement) for visualisation: x then z per node.
   virtual void nodePositions(const Vector& u, std::vector<double>& x, std::vector<double>& z) const = 0;

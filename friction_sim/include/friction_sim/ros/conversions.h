@@ -15,8 +15,8 @@
 #include <string>
 
 #include "friction_sim/instruments/instruments.h"
-#include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/instruments/slip_events.h"
+#include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/stage/stage.h"
 
 namespace friction {

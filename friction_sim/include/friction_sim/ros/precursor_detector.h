@@ -45,8 +45,8 @@ namespace friction {
 struct DetectorOptions {
   /// nodes in the sliding linear fit of the front speed v_c(x); 0 = the scene's, 5 without one
   int front_fit_nodes = 0;
-  std::string scene_path;   ///< the run's scene YAML, for the model's wave speeds; "" = unknown
-  std::string overrides;    ///< "key=value ..." scene fields the run replaced
+  std::string scene_path;  ///< the run's scene YAML, for the model's wave speeds; "" = unknown
+  std::string overrides;   ///< "key=value ..." scene fields the run replaced
 };
 
 /// Every problem of the options, each naming the parameter, the value and the allowed range.
@@ -55,8 +55,8 @@ std::vector<std::string> validateDetectorOptions(const DetectorOptions& options)
 DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh);
 /// What the detector takes from the run's scene.
 struct DetectorSettings {
-  WaveSpeeds wave_speeds;    ///< m/s, the model's (all 0, unknown, without a scene)
-  int front_fit_nodes = 5;  ///< the options' or the scene's
+  WaveSpeeds wave_speeds;      ///< m/s, the model's (all 0, unknown, without a scene)
+  int front_fit_nodes = 5;     ///< the options' or the scene's
   double slider_length = 0.0;  ///< m, L of L_p/L: the scene's geometry.length; 0 without a scene
   /// Whether the detector measures the same with `other`.
   bool sameAs(const DetectorSettings& other) const {
@@ -86,7 +86,7 @@ class PrecursorDetector {
   ros::NodeHandle nh_, private_nh_;
   std::unique_ptr<FrameEventDetector> detector_;
   int front_fit_nodes_option_;  ///< ~front_fit_nodes, 0 = the scene's
-  DetectorSettings settings_;  ///< in use
+  DetectorSettings settings_;   ///< in use
   std::vector<double> positions_;
   std::string frame_id_;  ///< the interface frames', for the events
   long frames_seen_ = 0;  ///< interface frames since the analysis last started over

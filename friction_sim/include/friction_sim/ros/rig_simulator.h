@@ -60,8 +60,8 @@
 // parameter is refused, 4 when the run was aborted.
 //
 // Commands with NaN/inf, a normal load <= 0 or beyond largestNormalForce (5 % of E over the slider's
-// base), a speed beyond the scene's stage.max_speed or an unknown mode are refused with a logged reason; the simulation keeps running. A HOLD's speed and target are
-// ignored: a hold has none.
+// base), a speed beyond the scene's stage.max_speed or an unknown mode are refused with a logged reason; the simulation
+// keeps running. A HOLD's speed and target are ignored: a hold has none.
 #pragma once
 
 #include <friction_msgs/SendStageCommand.h>
@@ -78,28 +78,28 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/run/run_driver.h"
+#include "friction_sim/scene/loading_protocol.h"
 
 namespace friction {
 
 struct SimulatorOptions {
-  std::string scene_path;          ///< path of the scene YAML
-  std::string overrides;           ///< "key=value ..." scene fields to replace
-  double real_time_factor = 0.0;   ///< sim s per wall s; 0 = as fast as possible
-  double load_cell_rate = 1e4;     ///< Hz, simulated
-  double gauge_rate = 1e4;         ///< Hz, simulated
-  double interface_rate = 1e5;     ///< Hz, simulated, during events
+  std::string scene_path;              ///< path of the scene YAML
+  std::string overrides;               ///< "key=value ..." scene fields to replace
+  double real_time_factor = 0.0;       ///< sim s per wall s; 0 = as fast as possible
+  double load_cell_rate = 1e4;         ///< Hz, simulated
+  double gauge_rate = 1e4;             ///< Hz, simulated
+  double interface_rate = 1e5;         ///< Hz, simulated, during events
   double interface_idle_rate = 100.0;  ///< Hz, simulated, while all is stuck
-  double stage_state_rate = 1e3;   ///< Hz, simulated
-  double clock_rate = 1e4;         ///< Hz, simulated
-  double lattice_rate = 200.0;     ///< Hz, simulated
-  double snapshot_rate = 20.0;     ///< Hz, wall
-  std::string bag_path;            ///< "" = no bag
-  std::string frame_id = "slider";  ///< frame of every message, the slider's (x along the track, z up)
-  bool stop_at_scene_end = true;   ///< end the run when the scene's stop condition holds
-  bool start_paused = false;       ///< wait at t = 0 until `pause` is called with false
+  double stage_state_rate = 1e3;       ///< Hz, simulated
+  double clock_rate = 1e4;             ///< Hz, simulated
+  double lattice_rate = 200.0;         ///< Hz, simulated
+  double snapshot_rate = 20.0;         ///< Hz, wall
+  std::string bag_path;                ///< "" = no bag
+  std::string frame_id = "slider";     ///< frame of every message, the slider's (x along the track, z up)
+  bool stop_at_scene_end = true;       ///< end the run when the scene's stop condition holds
+  bool start_paused = false;           ///< wait at t = 0 until `pause` is called with false
 };
 
 /// Every problem of the options, each naming the parameter, the value and the allowed range.
@@ -158,7 +158,7 @@ class RigSimulator {
   Scene scene_;
   double stability_limit_ = 0.0;  ///< s, of scene_, from its validation
   const Simulation& simulation() const { return driver_->simulation(); }
-  std::unique_ptr<RunDriver> driver_;  ///< the run since the start or the last reset
+  std::unique_ptr<RunDriver> driver_;                               ///< the run since the start or the last reset
   const SampledStream<LatticeSnapshot>* lattice_stream_ = nullptr;  ///< driver_'s
   std::vector<double> interface_positions_;
   WaveSpeeds wave_speeds_;
@@ -168,7 +168,7 @@ class RigSimulator {
   bool stop_ = false;
   bool aborted_ = false;
   bool reset_requested_ = false;
-  int scenes_recorded_ = 0;    ///< scene messages written to the bag
+  int scenes_recorded_ = 0;   ///< scene messages written to the bag
   std::uint32_t resets_ = 0;  ///< resets so far, in stage_state: a controller cannot always tell one by the time
   std::uint32_t frame_index_ = 0;
   ros::WallTime next_snapshot_, pace_origin_wall_;

@@ -9,8 +9,8 @@
 #include <map>
 #include <string>
 
-#include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/run/simulation.h"
+#include "friction_sim/scene/loading_protocol.h"
 
 namespace friction {
 

@@ -13,8 +13,8 @@
 #include <utility>
 #include <vector>
 
-#include "friction_sim/run/command_schedule.h"
 #include "friction_sim/instruments/instruments.h"
+#include "friction_sim/run/command_schedule.h"
 #include "friction_sim/run/simulation.h"
 
 namespace friction {
@@ -75,7 +75,8 @@ class SampledStream : public RunStream {
   void before(const Simulation& simulation, bool commands_applied) override {
     // Interpolated, the reading after the last advance serves unless a command changed the state since.
     // At steps, a plain step needs no reading before it.
-    const bool needed = sampling_ == Sampling::Interpolated ? commands_applied || !before_current_ : simulation.mayJump();
+    const bool needed =
+        sampling_ == Sampling::Interpolated ? commands_applied || !before_current_ : simulation.mayJump();
     if (needed) before_ = read_(simulation);
   }
 

@@ -13,13 +13,13 @@
 
 #include "friction_sim/contact/contact_interface.h"
 #include "friction_sim/instruments/instruments.h"
-#include "friction_sim/solvers/integrator.h"
-#include "friction_sim/scene/loading_protocol.h"
-#include "friction_sim/model/model.h"
-#include "friction_sim/scene/scene.h"
 #include "friction_sim/instruments/slip_events.h"
-#include "friction_sim/stage/stage.h"
+#include "friction_sim/model/model.h"
 #include "friction_sim/run/energy_ledger.h"
+#include "friction_sim/scene/loading_protocol.h"
+#include "friction_sim/scene/scene.h"
+#include "friction_sim/solvers/integrator.h"
+#include "friction_sim/stage/stage.h"
 
 namespace friction {
 
@@ -63,7 +63,7 @@ class Simulation : public Dynamics {
 
   double time() const { return time_; }  ///< s, simulated time since the stage started
   long long steps() const { return steps_; }
-  double timeStep() const { return dt_; }          ///< s
+  double timeStep() const { return dt_; }                     ///< s
   double stabilityLimit() const { return stability_limit_; }  ///< s
 
   LoadCellReading loadCells() const;

@@ -23,12 +23,12 @@ enum class ProtocolAction { NormalLoad, Hold, Drive, MoveTo };
 
 struct ProtocolStep {
   ProtocolAction action = ProtocolAction::Drive;  ///< what the step does: normal_load, hold, drive or move_to
-  double normal_force = 0.0;  ///< N, F_Z to reach (normal_load)
+  double normal_force = 0.0;                      ///< N, F_Z to reach (normal_load)
   /// s, F_Z ramps over this time (normal_load; 0 = at once): a staircase of ramp_commands equal steps,
   /// the k-th at (k − 1)/n of it, so that F_Z reaches its target at (n − 1)/n·ramp_time.
   double ramp_time = 0.0;
-  double speed = 4.0e-4;      ///< m/s, stage speed (drive, signed) or travel speed (move_to)
-  double target = 0.0;        ///< m, stage position (move_to)
+  double speed = 4.0e-4;  ///< m/s, stage speed (drive, signed) or travel speed (move_to)
+  double target = 0.0;    ///< m, stage position (move_to)
   double duration = std::numeric_limits<double>::infinity();  ///< s, how long the step lasts (hold, drive, move_to)
 };
 
@@ -40,16 +40,16 @@ struct ProtocolEnd {
 
 struct LoadingProtocol {
   std::vector<ProtocolStep> steps{ProtocolStep{}};  ///< run in order; the last one persists
-  ProtocolEnd end;  ///< when the protocol, and the run, ends
-  int ramp_commands = 20;  ///< F_Z commands (equal steps) per ramp, n >= 1
+  ProtocolEnd end;                                  ///< when the protocol, and the run, ends
+  int ramp_commands = 20;                           ///< F_Z commands (equal steps) per ramp, n >= 1
 };
 
 /// A command to the rig at a simulated time.
 struct TimedCommand {
   enum class Kind { Stage, NormalLoad };
-  double time = 0.0;  ///< s, simulated
-  Kind kind = Kind::Stage;  ///< a stage command, or a new F_Z
-  StageCommand stage;       ///< the stage's mode, speed and target (kind Stage)
+  double time = 0.0;          ///< s, simulated
+  Kind kind = Kind::Stage;    ///< a stage command, or a new F_Z
+  StageCommand stage;         ///< the stage's mode, speed and target (kind Stage)
   double normal_force = 0.0;  ///< N
 };
 

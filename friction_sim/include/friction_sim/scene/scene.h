@@ -47,17 +47,17 @@ struct LatticeSpec {
 };
 
 struct ChainSpec {
-  int blocks = 57;                         ///< N, number of blocks (1 = a single block on a spring)
+  int blocks = 57;                            ///< N, number of blocks (1 = a single block on a spring)
   ChainDriving driving = ChainDriving::Side;  ///< side: pusher on block 0; top: K/N on every block
-  double tilt = 0.0;           ///< θ, dimensionless tilt of the normal load (θ > 0 loads the leading edge)
-  double torque_share = 0.0;   ///< g ∈ [0, 1], share of the moment h·F_X carried by the interface
+  double tilt = 0.0;          ///< θ, dimensionless tilt of the normal load (θ > 0 loads the leading edge)
+  double torque_share = 0.0;  ///< g ∈ [0, 1], share of the moment h·F_X carried by the interface
   /// N, per-block friction force at t = 0 (empty: no stored shear); length must equal `blocks`
   std::vector<double> initial_shear;
 };
 
 struct FrictionSpec {
   FrictionLawKind law = FrictionLawKind::AmontonsCoulomb;  ///< the sliding resistance µ (MODEL.md §4)
-  double static_coefficient = 0.4;    ///< µ_s, dimensionless: a stuck node holds up to µ_s·N
+  double static_coefficient = 0.4;                         ///< µ_s, dimensionless: a stuck node holds up to µ_s·N
   double kinetic_coefficient = 0.17;  ///< µ_k, dimensionless (≤ µ_s): sliding friction, after weakening
   double weakening_length = 0.0;      ///< m, ξ_µ of linear slip weakening (0 = Amontons–Coulomb)
   /// N/m, k_T: a stuck node is held by this spring to its anchor; 0 = rigid stick constraint
@@ -65,7 +65,7 @@ struct FrictionSpec {
 };
 
 struct LoadSpec {
-  double normal_force = 1920.0;  ///< N, F_Z pressed on the top face (downwards)
+  double normal_force = 1920.0;            ///< N, F_Z pressed on the top face (downwards)
   TopLoadKind top = TopLoadKind::Uniform;  ///< 2D only: how F_Z reaches the top row
   /// The interface's tangential motion while F_Z is applied. 2D only in effect: the chain has no Poisson
   /// expansion, so F_Z moves none of its blocks either way.
@@ -87,14 +87,14 @@ struct PusherSpec {
 /// One segment of the stage program.
 struct StageSegment {
   StageMode mode = StageMode::Velocity;  ///< drive at `speed`, hold still, or travel to `target`
-  double speed = 4.0e-4;    ///< m/s, stage speed (velocity mode) or travel speed (position mode)
-  double target = 0.0;      ///< m, stage position to reach (position mode)
+  double speed = 4.0e-4;                 ///< m/s, stage speed (velocity mode) or travel speed (position mode)
+  double target = 0.0;                   ///< m, stage position to reach (position mode)
   double duration = std::numeric_limits<double>::infinity();  ///< s, how long the segment lasts
 };
 
 struct StageSpec {
   std::vector<StageSegment> program{StageSegment{}};  ///< segments run in order; the last one persists
-  double max_speed = 1.0;  ///< m/s, commands faster than this are refused
+  double max_speed = 1.0;                             ///< m/s, commands faster than this are refused
 };
 
 struct IntegratorSpec {
@@ -106,10 +106,10 @@ struct IntegratorSpec {
 };
 
 struct InstrumentSpec {
-  double loading_curve_rate = 1.0e4;  ///< Hz of simulated time, load-cell samples (F_X, F_Z, ΣN, N_sliding)
-  double gauge_height = 0.002;        ///< m, z_g of the strain gauges above the interface
+  double loading_curve_rate = 1.0e4;    ///< Hz of simulated time, load-cell samples (F_X, F_Z, ΣN, N_sliding)
+  double gauge_height = 0.002;          ///< m, z_g of the strain gauges above the interface
   std::vector<double> gauge_positions;  ///< m, gauge x positions; empty = every lattice column
-  int front_fit_nodes = 5;  ///< nodes in the sliding linear fit of first-unstick times for v_c(x)
+  int front_fit_nodes = 5;              ///< nodes in the sliding linear fit of first-unstick times for v_c(x)
 };
 
 struct StopSpec {
@@ -129,7 +129,7 @@ constexpr const char* kNoEndProblem =
     "no condition, so the run would never end; give global_events, time or stage_travel";
 
 struct Scene {
-  std::string name = "pmma_2d";  ///< names the run's results (results/<name>) and its summary
+  std::string name = "pmma_2d";            ///< names the run's results (results/<name>) and its summary
   ModelKind model = ModelKind::Lattice2D;  ///< 2D lattice in the x–z plane, or 1D chain of blocks
   GeometrySpec geometry;
   MaterialSpec material;

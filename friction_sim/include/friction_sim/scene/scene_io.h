@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "friction_sim/scene/scene.h"
 #include "friction_sim/scene/config_error.h"
+#include "friction_sim/scene/scene.h"
 
 namespace friction {
 

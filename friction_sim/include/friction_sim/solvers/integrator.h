@@ -27,8 +27,7 @@ class Integrator {
   /// Advances (u, v) from t to t + dt. On entry `a` (sized like u) and `power` are the acceleration and
   /// dissipated power at the start of the step; on exit, at its end. Returns the energy (J) dissipated by the
   /// velocity-dependent forces during the step, integrated with the scheme's own quadrature.
-  virtual double step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
-                      double dt) = 0;
+  virtual double step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t, double dt) = 0;
 };
 
 /// Velocity Verlet's passes over the state, run by a force evaluation strip by strip (StripHooks): a
@@ -57,15 +56,13 @@ class VerletPasses : public StripHooks {
 /// Its passes run inside the force evaluation's strips (Dynamics::accelerationInStrips).
 class VelocityVerlet : public Integrator {
  public:
-  double step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
-              double dt) override;
+  double step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t, double dt) override;
 };
 
 /// Classical RK4 on the first-order system (u, v); one extra evaluation at the end gives `a`.
 class RungeKutta4 : public Integrator {
  public:
-  double step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
-              double dt) override;
+  double step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t, double dt) override;
 
  private:
   Vector u_stage_, v_stage_, k_u_[4], k_v_[4];

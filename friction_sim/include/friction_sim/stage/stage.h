@@ -20,9 +20,9 @@ class Stage {
   /// (immune to round-off in the sum of the steps), also when the stage is advanced by a longer jump.
   Stage(const StageSpec& spec, double time_step);
 
-  double position() const { return position_; }  ///< m, X_s
-  double velocity() const;                        ///< m/s, dX_s/dt now
-  double travel() const { return travel_; }       ///< m, total distance moved
+  double position() const { return position_; }             ///< m, X_s
+  double velocity() const;                                  ///< m/s, dX_s/dt now
+  double travel() const { return travel_; }                 ///< m, total distance moved
   const StageCommand& current() const { return current_; }  ///< what the stage is doing now
   /// m, where the stage will be `lead` seconds from now if nothing changes (for stages within a step).
   double positionAfter(double lead) const;

@@ -12,8 +12,7 @@ namespace {
 constexpr double kStuckMode = 2.0;
 }  // namespace
 
-ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model& model,
-                                   double tangential_stiffness)
+ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model& model, double tangential_stiffness)
     : law_(std::move(law)), uniform_law_(law_->uniform()), k_t_(tangential_stiffness) {
   const int n = model.interfaceNodeCount();
   for (int node = 0; node < n; ++node) dofs_.push_back(model.interfaceDof(node));
@@ -95,8 +94,8 @@ template <bool kRigid, bool kUniform>
 std::int64_t frictionPass(int n, double k_t, double inverse_mass, const double* __restrict x,
                           const double* __restrict anchor, const double* __restrict normal,
                           const double* __restrict static_mu, const double* __restrict mu,
-                          const double* __restrict mode, double* __restrict other,
-                          double* __restrict friction, double* __restrict force_to_acceleration) {
+                          const double* __restrict mode, double* __restrict other, double* __restrict friction,
+                          double* __restrict force_to_acceleration) {
   // Counted in 64 bits, the width of every other lane of the loop: a mix of widths costs conversions.
   std::int64_t attention = 0;
   if (n <= 0) return attention;
@@ -143,11 +142,11 @@ void ContactInterface::accelerateWithFriction(const double* u, const double* nor
   latest_normal_ = normal;
   auto* pass = k_t_ <= 0.0 ? (uniform_law_ ? frictionPass<true, true> : frictionPass<true, false>)
                            : (uniform_law_ ? frictionPass<false, true> : frictionPass<false, false>);
-  attention_ += pass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node,
-                     normal + first_node, static_coefficient_.data() + first_node,
-                     sliding_coefficient_.data() + first_node, friction_mode_.data() + first_node,
-                     other_force_.data() + first_node,
-                     friction_[current_slot_].data() + first_node, force_to_acceleration + offset);
+  attention_ +=
+      pass(end_node - first_node, k_t_, inverse_mass, u + offset, anchor_.data() + first_node, normal + first_node,
+           static_coefficient_.data() + first_node, sliding_coefficient_.data() + first_node,
+           friction_mode_.data() + first_node, other_force_.data() + first_node,
+           friction_[current_slot_].data() + first_node, force_to_acceleration + offset);
 }
 
 void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,

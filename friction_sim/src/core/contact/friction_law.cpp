@@ -8,8 +8,7 @@ namespace friction {
 AmontonsCoulomb::AmontonsCoulomb(double static_coefficient, double kinetic_coefficient)
     : static_(static_coefficient), kinetic_(kinetic_coefficient) {}
 
-LinearSlipWeakening::LinearSlipWeakening(double static_coefficient, double kinetic_coefficient,
-                                         double weakening_length)
+LinearSlipWeakening::LinearSlipWeakening(double static_coefficient, double kinetic_coefficient, double weakening_length)
     : static_(static_coefficient), kinetic_(kinetic_coefficient), weakening_length_(weakening_length) {}
 
 double LinearSlipWeakening::slidingCoefficient(int node) const {

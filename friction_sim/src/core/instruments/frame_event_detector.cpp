@@ -26,13 +26,11 @@ void FrameEventDetector::reset() {
   last_frame_time_ = -std::numeric_limits<double>::infinity();
 }
 
-void FrameEventDetector::addLoadCells(const LoadCellReading& reading) {
-  load_cells_.push_back(reading);
-}
+void FrameEventDetector::addLoadCells(const LoadCellReading& reading) { load_cells_.push_back(reading); }
 
 std::vector<SlipEvent> FrameEventDetector::takeCompletedEvents(bool no_more_readings) {
   std::vector<SlipEvent> ready;
-  const double latest = no_more_readings     ? std::numeric_limits<double>::infinity()
+  const double latest = no_more_readings      ? std::numeric_limits<double>::infinity()
                         : load_cells_.empty() ? -std::numeric_limits<double>::infinity()
                                               : load_cells_.back().time;
   while (!ended_.empty() && ended_.front().end_time <= latest) {
@@ -59,11 +57,11 @@ void FrameEventDetector::addLoadCellsTo(SlipEvent& event) const {
   double shear_impulse = 0.0, normal_impulse = 0.0, span = 0.0;
   // The peak F_X is watched until the whole interface has slipped (SlipEvent::peak_shear_force).
   // The nodes lifted throughout have no first-unstick time (NaN), which fmax passes over.
-  const double peak_until =
-      event.global ? std::accumulate(event.first_unstick_time.begin(), event.first_unstick_time.end(),
-                                     -std::numeric_limits<double>::infinity(),
-                                     [](double a, double b) { return std::fmax(a, b); })
-                   : event.end_time;
+  const double peak_until = event.global
+                                ? std::accumulate(event.first_unstick_time.begin(), event.first_unstick_time.end(),
+                                                  -std::numeric_limits<double>::infinity(),
+                                                  [](double a, double b) { return std::fmax(a, b); })
+                                : event.end_time;
   for (const LoadCellReading& reading : load_cells_) {
     if (reading.time <= event.onset_time) {
       event.onset_shear_force = event.peak_shear_force = reading.shear_force;

@@ -102,7 +102,7 @@ std::uint64_t Simulation::stateHash() const {
     mix(&state, sizeof state);
   }
   for (const SlipEvent& event : events()) {
-    const double numbers[] = {event.onset_time, event.end_time, event.onset_shear_force,
+    const double numbers[] = {event.onset_time,       event.end_time,       event.onset_shear_force,
                               event.mean_shear_force, event.rupture_length, event.nucleation_position};
     mix(numbers, sizeof numbers);
     mix(event.node_slip.data(), sizeof(double) * event.node_slip.size());

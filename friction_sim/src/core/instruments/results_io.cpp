@@ -43,10 +43,11 @@ void printSummary(std::ostream& out, const RunSummary& s) {
   out << "scene " << s.scene_name << ": " << s.stop_reason << "\n"
       << "  simulated " << s.simulated_time << " s in " << s.steps << " steps of " << s.time_step
       << " s (stability limit " << s.stability_limit << " s)\n"
-      << "  wall time " << std::setprecision(3) << s.wall_time << " s, "
-      << std::setprecision(4) << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
+      << "  wall time " << std::setprecision(3) << s.wall_time << " s, " << std::setprecision(4)
+      << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
       << "  slip events: " << s.events << ", precursors before the first global event: " << s.precursors;
-  if (s.single_node_precursors > 0) out << " (single-node slips, L_p = 0, among them: " << s.single_node_precursors << ")";
+  if (s.single_node_precursors > 0)
+    out << " (single-node slips, L_p = 0, among them: " << s.single_node_precursors << ")";
   if (s.back_slips > 0) out << "; back-slips before it, not counted: " << s.back_slips;
   out << "\n";
   if (!s.precursor_points.empty()) {
@@ -73,13 +74,13 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (const SlipEvent& e : events) {
     out << e.index << ',' << e.onset_time << ',' << e.end_time << ',' << e.onset_shear_force << ','
-        << e.onset_normal_force << ',' << e.onset_shear_force / e.onset_normal_force << ',' << e.end_shear_force
-        << ',' << e.nucleation_position << ',' << e.slip_min_x << ',' << e.slip_max_x << ',' << e.rupture_length
-        << ',' << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << e.median_front_speed
-        << ',' << e.median_front_speed / speeds.shear << ','
-        << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out
-        << ',' << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio() << ','
-        << e.peak_shear_force << ',' << e.peakShearRatio() << ',' << e.meanSlip() << '\n';
+        << e.onset_normal_force << ',' << e.onset_shear_force / e.onset_normal_force << ',' << e.end_shear_force << ','
+        << e.nucleation_position << ',' << e.slip_min_x << ',' << e.slip_max_x << ',' << e.rupture_length << ','
+        << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << e.median_front_speed << ','
+        << e.median_front_speed / speeds.shear << ','
+        << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out << ','
+        << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio() << ',' << e.peak_shear_force
+        << ',' << e.peakShearRatio() << ',' << e.meanSlip() << '\n';
   }
 }
 

@@ -31,8 +31,8 @@ SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, do
   onset_u_.resize(positions_.size());
 }
 
-bool SlipEventDetector::update(double step_start, double dt, const ContactInterface& contact,
-                               const Vector& u, const StepLoads& loads) {
+bool SlipEventDetector::update(double step_start, double dt, const ContactInterface& contact, const Vector& u,
+                               const StepLoads& loads) {
   const auto& unstuck = contact.unstuckLastStep();
   auto transition_time = [&](int node) { return step_start + contact.transitionFraction(node) * dt; };
   auto shear_at = [&](double time) {
@@ -61,9 +61,8 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
   }
   if (!in_event_) return false;
-  in_contact_.note(static_cast<std::size_t>(contact.detachedCount()), [&contact](std::size_t node) {
-    return contact.state(static_cast<int>(node));
-  });
+  in_contact_.note(static_cast<std::size_t>(contact.detachedCount()),
+                   [&contact](std::size_t node) { return contact.state(static_cast<int>(node)); });
   const bool was_global = slipped_ == in_contact_.count();
   double last_first_unstick = step_start;  // of the nodes slipping for the first time in this step
   for (int node : unstuck) {
@@ -120,8 +119,8 @@ FitWindow frontFitWindow(int fit_nodes) {
   return {nodes / 2, (nodes - 1) / 2};
 }
 
-std::vector<double> frontSpeeds(const std::vector<double>& positions,
-                                const std::vector<double>& first_unstick_time, int fit_nodes) {
+std::vector<double> frontSpeeds(const std::vector<double>& positions, const std::vector<double>& first_unstick_time,
+                                int fit_nodes) {
   const int n = static_cast<int>(positions.size());
   std::vector<double> speed(n, kNaN);
   const auto [behind, ahead] = frontFitWindow(fit_nodes);

@@ -27,8 +27,7 @@ Chain1D::Chain1D(const Scene& scene)
       length_(scene.geometry.length),
       spacing_(n_ > 1 ? length_ / (n_ - 1) : length_),
       mass_(scene.material.density * length_ * scene.geometry.height * scene.geometry.width / n_),
-      k_(n_ > 1 ? scene.material.youngs_modulus * scene.geometry.height * scene.geometry.width / spacing_
-                : 0.0),
+      k_(n_ > 1 ? scene.material.youngs_modulus * scene.geometry.height * scene.geometry.width / spacing_ : 0.0),
       eta_(std::sqrt(scene.material.damping_coefficient * k_ * mass_)),
       area_per_block_(spacing_ * scene.geometry.width),
       top_driving_(scene.chain.driving == ChainDriving::Top),
@@ -63,7 +62,8 @@ double Chain1D::torqueCoefficient(double shear_force) const {
 }
 
 auto Chain1D::normalForceExpression(double shear_force, int first, int count) const {
-  return normal_force_ / n_ * tilt_factor_.segment(first, count) + torqueCoefficient(shear_force) * xi_.segment(first, count);
+  return normal_force_ / n_ * tilt_factor_.segment(first, count) +
+         torqueCoefficient(shear_force) * xi_.segment(first, count);
 }
 
 void Chain1D::writeNormalForces(double shear_force, int first, int count, Vector& normal_forces) const {
@@ -151,7 +151,7 @@ void Chain1D::evaluateSideDriven(const Vector& u, const Vector& v, double stage_
   double left_tension = 0.0;
   for (int first = 0; first < n_; first += strip_nodes) {
     const int end = std::min(n_, first + strip_nodes);
-    prepareThrough(std::min(n_, end + 1));  // the last block's bond reads the next strip's first block
+    prepareThrough(std::min(n_, end + 1));        // the last block's bond reads the next strip's first block
     const int bonds_end = std::min(end, n_ - 1);  // the bonds whose left block is in the strip
     f[first] = (first < n_ - 1 ? tension(first) : 0.0) - left_tension;
     bondForces(first + 1, bonds_end, k_, eta_, x, w, f);
@@ -161,7 +161,9 @@ void Chain1D::evaluateSideDriven(const Vector& u, const Vector& v, double stage_
     writeNormalForces(shear, first, count, out.normal_force);
     if (bonds_end > first) {
       squared_velocity_differences +=
-          (v.segment(first + 1, bonds_end - first).array() - v.segment(first, bonds_end - first).array()).square().sum();
+          (v.segment(first + 1, bonds_end - first).array() - v.segment(first, bonds_end - first).array())
+              .square()
+              .sum();
     }
     if (end < n_) left_tension = tension(end - 1);
     hooks.finish(first, end);

@@ -33,8 +33,7 @@ Lattice2D::Lattice2D(const Scene& scene)
       n_(nx_ * nz_),
       spacing_(scene.geometry.length / (nx_ - 1)),
       width_(scene.geometry.width),
-      mass_(scene.material.density * scene.geometry.length * scene.geometry.height *
-            scene.geometry.width / n_),
+      mass_(scene.material.density * scene.geometry.length * scene.geometry.height * scene.geometry.width / n_),
       k_(0.75 * scene.geometry.width * scene.material.youngs_modulus),
       eta_(std::sqrt(scene.material.damping_coefficient * k_ * mass_)),
       kf_(scene.lattice.foundation_ratio * k_),
@@ -106,9 +105,9 @@ struct NodeArrays {
 /// Lattice2D::bondTension's rule out with a square root in place of std::hypot, so that the loop
 /// vectorises.
 template <bool kGeometric>
-void bondRow(const NodeArrays& nodes, int a0, int b0, int count, double rest_x, double rest_z,
-             double rest_length, double stiffness, double eta, double* __restrict out_x,
-             double* __restrict out_z, double* __restrict power) {
+void bondRow(const NodeArrays& nodes, int a0, int b0, int count, double rest_x, double rest_z, double rest_length,
+             double stiffness, double eta, double* __restrict out_x, double* __restrict out_z,
+             double* __restrict power) {
   const double* __restrict ux = nodes.ux;
   const double* __restrict uz = nodes.uz;
   const double* __restrict vx = nodes.vx;
@@ -467,12 +466,9 @@ std::array<double, 3> Lattice2D::cellStress(const Vector& u, int i, int j) const
     double weight;
     const BondFamily* family;
   };
-  const CellBond bonds[6] = {{i, j, i + 1, j, 0.5, &families_[0]},
-                             {i, j + 1, i + 1, j + 1, 0.5, &families_[0]},
-                             {i, j, i, j + 1, 0.5, &families_[1]},
-                             {i + 1, j, i + 1, j + 1, 0.5, &families_[1]},
-                             {i, j, i + 1, j + 1, 1.0, &families_[2]},
-                             {i + 1, j, i, j + 1, 1.0, &families_[3]}};
+  const CellBond bonds[6] = {{i, j, i + 1, j, 0.5, &families_[0]},     {i, j + 1, i + 1, j + 1, 0.5, &families_[0]},
+                             {i, j, i, j + 1, 0.5, &families_[1]},     {i + 1, j, i + 1, j + 1, 0.5, &families_[1]},
+                             {i, j, i + 1, j + 1, 1.0, &families_[2]}, {i + 1, j, i, j + 1, 1.0, &families_[3]}};
   std::array<double, 3> stress{0.0, 0.0, 0.0};  // σ_xx, σ_zz, τ_xz
   for (const CellBond& bond : bonds) {
     const int a = nodeIndex(bond.ia, bond.ja);
@@ -480,7 +476,8 @@ std::array<double, 3> Lattice2D::cellStress(const Vector& u, int i, int j) const
     const BondFamily& family = *bond.family;
     const double rx = family.ex * family.rest_length + u[xDof(b)] - u[xDof(a)];
     const double rz = family.ez * family.rest_length + u[zDof(b)] - u[zDof(a)];
-    const double tension = bondTension(family, rx, rz, u[xDof(b)] - u[xDof(a)], u[zDof(b)] - u[zDof(a)]).tension_per_length;
+    const double tension =
+        bondTension(family, rx, rz, u[xDof(b)] - u[xDof(a)], u[zDof(b)] - u[zDof(a)]).tension_per_length;
     stress[0] += bond.weight * tension * rx * rx;
     stress[1] += bond.weight * tension * rz * rz;
     stress[2] += bond.weight * tension * rx * rz;
@@ -490,8 +487,7 @@ std::array<double, 3> Lattice2D::cellStress(const Vector& u, int i, int j) const
   return stress;
 }
 
-GaugeStresses Lattice2D::gaugeStresses(const Vector& u, double height,
-                                       const std::vector<double>& positions) const {
+GaugeStresses Lattice2D::gaugeStresses(const Vector& u, double height, const std::vector<double>& positions) const {
   GaugeStresses out;
   // Cell centres sit at ((i + ½)l, (j + ½)l); interpolate bilinearly between them, clamped at the edges.
   auto bracket = [](double coordinate, int cells, int& low, double& fraction) {
@@ -512,8 +508,7 @@ GaugeStresses Lattice2D::gaugeStresses(const Vector& u, double height,
     const auto s01 = cellStress(u, i0, j1), s11 = cellStress(u, i1, j1);
     double value[3];
     for (int c = 0; c < 3; ++c) {
-      value[c] = (1 - fx) * (1 - fz) * s00[c] + fx * (1 - fz) * s10[c] + (1 - fx) * fz * s01[c] +
-                 fx * fz * s11[c];
+      value[c] = (1 - fx) * (1 - fz) * s00[c] + fx * (1 - fz) * s10[c] + (1 - fx) * fz * s01[c] + fx * fz * s11[c];
     }
     out.sigma_xx.push_back(value[0]);
     out.sigma_zz.push_back(value[1]);

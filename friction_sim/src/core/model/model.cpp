@@ -20,7 +20,8 @@ int Model::evaluateSuccessiveInStrips(int strip_nodes,
     const std::optional<StripEvaluation> evaluation = next(count);
     if (!evaluation) return count;
     if (count == successiveEvaluations()) {
-      throw std::logic_error("Model::evaluateSuccessiveInStrips: asked for more evaluations than successiveEvaluations()");
+      throw std::logic_error(
+          "Model::evaluateSuccessiveInStrips: asked for more evaluations than successiveEvaluations()");
     }
     evaluateInStrips(evaluation->u, evaluation->v, evaluation->stage_position, evaluation->force, evaluation->out,
                      evaluation->hooks, strip_nodes);

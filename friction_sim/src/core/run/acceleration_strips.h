@@ -22,8 +22,14 @@ class AccelerationStrips : public StripHooks {
  public:
   AccelerationStrips(StripHooks& caller, Vector& a, double inverse_mass, ContactInterface& contact,
                      const ForceEvaluation& evaluation, const Vector& u)
-      : caller_(caller), a_(a), inverse_mass_(inverse_mass), contact_(contact), evaluation_(evaluation), u_(u),
-        interface_begin_(contact.firstDof()), interface_end_(interface_begin_ + contact.size()) {}
+      : caller_(caller),
+        a_(a),
+        inverse_mass_(inverse_mass),
+        contact_(contact),
+        evaluation_(evaluation),
+        u_(u),
+        interface_begin_(contact.firstDof()),
+        interface_end_(interface_begin_ + contact.size()) {}
   void prepare(int first, int end) override { caller_.prepare(first, end); }
   void finish(int first, int end) override {
     scaleOutsideInterface(first, std::min(end, interface_begin_));

@@ -43,9 +43,9 @@ class FastForward {
  private:
   /// Where a jump along the equilibrium goes and how far.
   struct Path {
-    Vector along;          ///< du/dX_s along the equilibrium
-    Vector velocity;       ///< m/s, every free node moves with the stage
-    double length = 0.0;   ///< s, to the caller's time, the stage's next change, a stop limit or the first threshold
+    Vector along;         ///< du/dX_s along the equilibrium
+    Vector velocity;      ///< m/s, every free node moves with the stage
+    double length = 0.0;  ///< s, to the caller's time, the stage's next change, a stop limit or the first threshold
     bool stops_at_threshold = false;
   };
   /// One jump along the pinned equilibrium towards `until` or, if sooner, the next node's threshold

@@ -124,15 +124,15 @@ void Simulation::settleInterface() {
 void Simulation::concludeStep(const StepStart& start) {
   const bool was_in_event = detector_.inEvent();
   event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_,
-                                 {start.shear_force, evaluation_.shear_force, evaluation_.normal_load});
+                                  {start.shear_force, evaluation_.shear_force, evaluation_.normal_load});
   event_started_ = !was_in_event && (detector_.inEvent() || event_ended_);
   if (scene_.integrator.fast_forward) {
     if (event_started_ || start.stage_too_fast) fast_forward_->leavePath();
     // Back on the static path when an event ends, or when a node lifts off or lands in a step taken on
     // the path (the path goes on with the new set of nodes in contact). Not while the slider rings
     // after a fast stage move: only the end of an event brings it back then.
-    const bool contact_changed = start.was_quasi_static && contact_.contactChanges() != start.contact_changes &&
-                                 !detector_.inEvent();
+    const bool contact_changed =
+        start.was_quasi_static && contact_.contactChanges() != start.contact_changes && !detector_.inEvent();
     if ((event_ended_ || contact_changed) && !start.stage_too_fast && fast_forward_->relaxToStaticEquilibrium()) {
       fast_forward_->setQuasiStatic(true);
     }

@@ -47,8 +47,8 @@ std::string Simulation::setStopCondition(const StopSpec& stop) {
               << " s, the time now (inf: not this condition)";
   }
   if (!(stop.stage_travel > stage_.travel())) {
-    problem() << "stage_travel " << stop.stage_travel << " m is not allowed; allowed: > "
-              << stage_.travel() << " m, the travel now (inf: not this condition)";
+    problem() << "stage_travel " << stop.stage_travel << " m is not allowed; allowed: > " << stage_.travel()
+              << " m, the travel now (inf: not this condition)";
   }
   if (!endsTheRun(stop)) problem() << kNoEndProblem;
   if (!reason.str().empty()) return reason.str();

@@ -24,12 +24,12 @@ void Simulation::stepInGroup(double group_before) {
     std::array<StepStart, kMaxGroupSteps> starts;
     std::array<std::optional<AccelerationStrips>, kMaxGroupSteps> strips;
     bool last_concluded = true;
-  } group{std::min(model_->successiveEvaluations(), kMaxGroupSteps), group_before, VerletPasses(u_, v_, a_, dt_), {},
-          {}};
+  } group{
+      std::min(model_->successiveEvaluations(), kMaxGroupSteps), group_before, VerletPasses(u_, v_, a_, dt_), {}, {}};
   group.starts[0] = stepStart();
   contact_.beginStep(u_, v_);
-  const int steps = model_->evaluateSuccessiveInStrips(
-      kGroupStripNodes, [this, &group](int k) -> std::optional<StripEvaluation> {
+  const int steps =
+      model_->evaluateSuccessiveInStrips(kGroupStripNodes, [this, &group](int k) -> std::optional<StripEvaluation> {
         if (k > 0) {
           // Step k − 1's interface is final. With no node sliding, finishStep has nothing to re-stick: the
           // interface's end of the step is its state update alone (settleInterface).
@@ -51,8 +51,7 @@ void Simulation::stepInGroup(double group_before) {
         ForceEvaluation& evaluation = groupEvaluation(k);
         contact_.lendNormalStorage(evaluation.normal_force);
         group.strips[k].emplace(group.passes, a_, inverse_mass_, contact_, evaluation, u_);
-        return StripEvaluation{u_, v_, stage_.positionAfter((time_ + dt_) - time_), a_, evaluation,
-                               *group.strips[k]};
+        return StripEvaluation{u_, v_, stage_.positionAfter((time_ + dt_) - time_), a_, evaluation, *group.strips[k]};
       });
   // The steps' energy, in order, now that their sums are known; the clock stands at the last one's end.
   for (int k = 0; k < steps; ++k) {

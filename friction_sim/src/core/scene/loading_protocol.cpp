@@ -80,13 +80,16 @@ void checkProtocolValues(const LoadingProtocol& protocol, const ProtocolReading&
     if (i < reading.action_refused.size() && reading.action_refused[i]) continue;
     const std::string where = "steps[" + std::to_string(i) + "]";
     if (step.action == ProtocolAction::NormalLoad) {
-      if (!(step.normal_force > 0.0) || !std::isfinite(step.normal_force)) problem(where + ".normal_force", step.normal_force, "a finite F_Z > 0 N");
-      if (!(step.ramp_time >= 0.0) || !std::isfinite(step.ramp_time)) problem(where + ".ramp_time", step.ramp_time, "a finite time >= 0 s");
+      if (!(step.normal_force > 0.0) || !std::isfinite(step.normal_force))
+        problem(where + ".normal_force", step.normal_force, "a finite F_Z > 0 N");
+      if (!(step.ramp_time >= 0.0) || !std::isfinite(step.ramp_time))
+        problem(where + ".ramp_time", step.ramp_time, "a finite time >= 0 s");
       continue;
     }
     if (!(step.duration > 0.0)) problem(where + ".duration", step.duration, "a duration > 0 s (.inf allowed)");
     if (!std::isfinite(step.speed)) problem(where + ".speed", step.speed, "a finite speed in m/s");
-    if (step.action == ProtocolAction::MoveTo && !(step.speed > 0.0)) problem(where + ".speed", step.speed, "a travel speed > 0 m/s");
+    if (step.action == ProtocolAction::MoveTo && !(step.speed > 0.0))
+      problem(where + ".speed", step.speed, "a travel speed > 0 m/s");
     if (std::isinf(step.duration) && i + 1 < protocol.steps.size()) {
       problem(where + ".duration", step.duration, "a finite duration: later steps would never run");
     }
@@ -207,9 +210,7 @@ bool readStampSeconds(const std::string& text, double& seconds) {
   const auto point = text.find('.');
   const std::string whole = text.substr(0, point);
   const std::string fraction = point == std::string::npos ? "" : text.substr(point + 1);
-  const auto digits = [](const std::string& part) {
-    return part.find_first_not_of("0123456789") == std::string::npos;
-  };
+  const auto digits = [](const std::string& part) { return part.find_first_not_of("0123456789") == std::string::npos; };
   if (whole.empty() || whole.size() > 9 || fraction.size() > 9 || !digits(whole) || !digits(fraction)) {
     return readNumber(text, seconds);
   }
@@ -272,14 +273,17 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
   std::string line;
   int line_number = 0;
   const std::string where_prefix = source.empty() ? "line " : source + ", line ";
-  auto problem = [&](const std::string& what) { problems.push_back(where_prefix + std::to_string(line_number) + ": " + what); };
+  auto problem = [&](const std::string& what) {
+    problems.push_back(where_prefix + std::to_string(line_number) + ": " + what);
+  };
   bool header_seen = false;
   while (std::getline(text, line)) {
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (!header_seen) {
       header_seen = true;
-      if (line != kCommandTableHeader) problem("the header must be '" + std::string(kCommandTableHeader) + "', got '" + line + "'");
+      if (line != kCommandTableHeader)
+        problem("the header must be '" + std::string(kCommandTableHeader) + "', got '" + line + "'");
       continue;
     }
     if (line.empty()) continue;
@@ -307,8 +311,9 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
     }
     if (time_readable) commands.push_back(command);
   }
-  if (!header_seen) problems.push_back(where_prefix + "1: empty; a command table starts with its header '" +
-                                       std::string(kCommandTableHeader) + "'");
+  if (!header_seen)
+    problems.push_back(where_prefix + "1: empty; a command table starts with its header '" +
+                       std::string(kCommandTableHeader) + "'");
   if (!problems.empty()) throw ConfigError("command table", problems);
   return commands;
 }

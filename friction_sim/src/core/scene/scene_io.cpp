@@ -18,16 +18,14 @@
 namespace friction {
 
 // Names of the scene's enum values in YAML (found by YamlFieldReader through ADL).
-const EnumTable<ModelKind> kModelNames{{ModelKind::Lattice2D, "lattice_2d"},
-                                       {ModelKind::Chain1D, "chain_1d"}};
+const EnumTable<ModelKind> kModelNames{{ModelKind::Lattice2D, "lattice_2d"}, {ModelKind::Chain1D, "chain_1d"}};
 const EnumTable<SpringForm> kSpringFormNames{{SpringForm::Geometric, "geometric"},
                                              {SpringForm::Linearised, "linearised"}};
 const EnumTable<TopLoadKind> kTopLoadNames{{TopLoadKind::Uniform, "uniform"},
                                            {TopLoadKind::SpringMattress, "spring_mattress"}};
 const EnumTable<InterfaceLoading> kInterfaceLoadingNames{{InterfaceLoading::Stuck, "stuck"},
                                                          {InterfaceLoading::Free, "free"}};
-const EnumTable<ChainDriving> kDrivingNames{{ChainDriving::Side, "side"},
-                                            {ChainDriving::Top, "top"}};
+const EnumTable<ChainDriving> kDrivingNames{{ChainDriving::Side, "side"}, {ChainDriving::Top, "top"}};
 const EnumTable<FrictionLawKind> kLawNames{{FrictionLawKind::AmontonsCoulomb, "amontons_coulomb"},
                                            {FrictionLawKind::SlipWeakening, "slip_weakening"}};
 const EnumTable<IntegratorKind> kSchemeNames{{IntegratorKind::VelocityVerlet, "velocity_verlet"},
@@ -43,7 +41,6 @@ const EnumTable<ChainDriving>& enumTable(ChainDriving) { return kDrivingNames; }
 const EnumTable<FrictionLawKind>& enumTable(FrictionLawKind) { return kLawNames; }
 const EnumTable<IntegratorKind>& enumTable(IntegratorKind) { return kSchemeNames; }
 const EnumTable<StageMode>& enumTable(StageMode) { return kStageModeNames; }
-
 
 namespace {
 
@@ -205,7 +202,8 @@ YAML::Node loadMapping(const std::string& text, const std::string& what, const s
   try {
     root = YAML::Load(text);
   } catch (const YAML::Exception& error) {
-    throw ConfigError(what, {"YAML syntax error" + (source.empty() ? "" : " in '" + source + "'") + ": " + error.what()});
+    throw ConfigError(what,
+                      {"YAML syntax error" + (source.empty() ? "" : " in '" + source + "'") + ": " + error.what()});
   }
   if (!root.IsMap()) throw ConfigError(what, {what + ": expected a mapping at the top level"});
   return root;
@@ -263,8 +261,10 @@ std::string overridesYaml(const std::vector<std::pair<std::string, std::string>>
     if (index != std::string::npos) {
       // A list is one field: it is replaced whole (the unknown key "stage.program[0]" told no more).
       const std::string list = key.substr(0, index);
-      problems.push_back("override '" + key + "': an element of a list cannot be set on its own; give the whole list "
-                         "in YAML, " + list + "=[...] (as in sweeps/stage_speed.yaml)");
+      problems.push_back("override '" + key +
+                         "': an element of a list cannot be set on its own; give the whole list "
+                         "in YAML, " +
+                         list + "=[...] (as in sweeps/stage_speed.yaml)");
       continue;
     }
     YAML::Node node = root;

@@ -4,9 +4,9 @@
 #include <sstream>
 
 #include "friction_sim/model/chain_1d.h"
-#include "friction_sim/solvers/integrator.h"
 #include "friction_sim/model/lattice_2d.h"
 #include "friction_sim/scene/scene_io.h"
+#include "friction_sim/solvers/integrator.h"
 
 namespace friction {
 
@@ -64,8 +64,8 @@ void checkLattice(Checker& check, const Scene& s) {
     for (int intervals_x = 1; !square && intervals_x <= 10000; ++intervals_x) {
       const double intervals_z = intervals_x * s.geometry.height / s.geometry.length;
       if (std::abs(intervals_z - std::round(intervals_z)) > 1e-6 * intervals_z || std::round(intervals_z) < 1) continue;
-      allowed << "; sizes that fit " << s.geometry.length << " m x " << s.geometry.height << " m: nodes_x - 1 a multiple of "
-              << intervals_x << ", e.g. nodes_x: " << 2 * intervals_x + 1
+      allowed << "; sizes that fit " << s.geometry.length << " m x " << s.geometry.height
+              << " m: nodes_x - 1 a multiple of " << intervals_x << ", e.g. nodes_x: " << 2 * intervals_x + 1
               << ", nodes_z: " << 2 * std::lround(intervals_z) + 1;
       break;
     }
@@ -83,9 +83,8 @@ void checkChain(Checker& check, const Scene& s) {
   check.require(s.load.top == TopLoadKind::Uniform, "load.top", static_cast<double>(s.load.top),
                 "uniform (the chain has no top row)");
   if (!s.chain.initial_shear.empty()) {
-    check.require(static_cast<int>(s.chain.initial_shear.size()) == s.chain.blocks,
-                  "chain.initial_shear (length)", s.chain.initial_shear.size(),
-                  "one force per block (chain.blocks) or an empty list");
+    check.require(static_cast<int>(s.chain.initial_shear.size()) == s.chain.blocks, "chain.initial_shear (length)",
+                  s.chain.initial_shear.size(), "one force per block (chain.blocks) or an empty list");
     for (std::size_t i = 0; i < s.chain.initial_shear.size(); ++i) {
       check.require(std::isfinite(s.chain.initial_shear[i]), "chain.initial_shear[" + std::to_string(i) + "]",
                     s.chain.initial_shear[i], "a finite force in N");
@@ -114,7 +113,8 @@ void checkLoad(Checker& check, const Scene& s) {
   if (check.clean({"geometry.", "material.youngs_modulus", "load.normal_force"})) {
     std::ostringstream allowed;
     allowed << "at most " << largestNormalForce(s) << " N (a mean normal stress F_Z/(L*B) of 5 % of E: a small strain)";
-    check.require(s.load.normal_force <= largestNormalForce(s), "load.normal_force", s.load.normal_force, allowed.str());
+    check.require(s.load.normal_force <= largestNormalForce(s), "load.normal_force", s.load.normal_force,
+                  allowed.str());
   }
   check.nonNegative("load.mattress_stiffness", s.load.mattress_stiffness);
   check.nonNegative("load.mattress_horizontal_stiffness", s.load.mattress_horizontal_stiffness);
@@ -131,7 +131,8 @@ void checkPusher(Checker& check, const Scene& s) {
                  "pusher.band_min..geometry.height");
     if (lattice && s.lattice.nodes_z >= 2) {
       const double spacing = s.geometry.height / (s.lattice.nodes_z - 1);
-      const bool holds_a_row = std::floor(s.pusher.band_max / spacing + 1e-9) >= std::ceil(s.pusher.band_min / spacing - 1e-9);
+      const bool holds_a_row =
+          std::floor(s.pusher.band_max / spacing + 1e-9) >= std::ceil(s.pusher.band_min / spacing - 1e-9);
       check.require(holds_a_row, "pusher.band_max", s.pusher.band_max,
                     "a band [band_min, band_max] that contains at least one lattice row");
     }
@@ -146,8 +147,8 @@ void checkStage(Checker& check, const Scene& s) {
     check.require(std::isfinite(segment.speed) && std::abs(segment.speed) <= s.stage.max_speed, where + ".speed",
                   segment.speed, "|speed| <= stage.max_speed");
     if (i + 1 < s.stage.program.size()) {
-      check.require(segment.duration > 0.0 && std::isfinite(segment.duration), where + ".duration",
-                    segment.duration, "a finite duration > 0 s: later segments would never run");
+      check.require(segment.duration > 0.0 && std::isfinite(segment.duration), where + ".duration", segment.duration,
+                    "a finite duration > 0 s: later segments would never run");
     } else {
       check.require(segment.duration > 0.0, where + ".duration", segment.duration, "a duration > 0 s (.inf allowed)");
     }
@@ -271,8 +272,9 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
 std::vector<std::string> sceneWarnings(const Scene& s) {
   std::vector<std::string> warnings;
   if (s.friction.law == FrictionLawKind::SlipWeakening && s.friction.weakening_length == 0.0) {
-    warnings.push_back("friction.weakening_length: 0 m with friction.law slip_weakening drops the friction to mu_k "
-                       "at once, as amontons_coulomb does; give the slip distance xi_mu (m) over which it weakens");
+    warnings.push_back(
+        "friction.weakening_length: 0 m with friction.law slip_weakening drops the friction to mu_k "
+        "at once, as amontons_coulomb does; give the slip distance xi_mu (m) over which it weakens");
   }
   const double spacing = s.model == ModelKind::Lattice2D ? s.geometry.length / std::max(s.lattice.nodes_x - 1, 1)
                                                          : s.geometry.length / std::max(s.chain.blocks - 1, 1);
@@ -292,11 +294,10 @@ std::vector<std::string> sceneWarnings(const Scene& s) {
     // What the lattice must resolve is the cohesive zone, where the friction weakens, not ξ_µ itself: an
     // estimate is Λ ≈ G·ξ_µ/((µ_s − µ_k)·σ̄), G the shear modulus (the chain's E: it only stretches) and
     // σ̄ = F_Z/(L·B) the mean normal stress. The warning gives it so that the user can judge.
-    const double modulus = s.model == ModelKind::Lattice2D ? 3.0 / 8.0 * s.material.youngs_modulus
-                                                           : s.material.youngs_modulus;
+    const double modulus =
+        s.model == ModelKind::Lattice2D ? 3.0 / 8.0 * s.material.youngs_modulus : s.material.youngs_modulus;
     const double mean_normal_stress = s.load.normal_force / (s.geometry.length * s.geometry.width);
-    const double strength_drop =
-        (s.friction.static_coefficient - s.friction.kinetic_coefficient) * mean_normal_stress;
+    const double strength_drop = (s.friction.static_coefficient - s.friction.kinetic_coefficient) * mean_normal_stress;
     std::ostringstream text;
     text.precision(3);
     text << "friction.weakening_length: " << s.friction.weakening_length << " m is shorter than one node spacing ("

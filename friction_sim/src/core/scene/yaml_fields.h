@@ -37,8 +37,7 @@ std::string allowedNames(const EnumTable<E>& table) {
 
 class YamlFieldReader {
  public:
-  YamlFieldReader(const YAML::Node& root, std::vector<std::string>& problems)
-      : node_(root), problems_(problems) {}
+  YamlFieldReader(const YAML::Node& root, std::vector<std::string>& problems) : node_(root), problems_(problems) {}
 
   template <class T>
   void field(const char* key, T& value) {
@@ -167,8 +166,7 @@ class YamlFieldReader {
         return;
       }
     }
-    problems_.push_back(where + ": value '" + text + "' is not allowed; allowed: " +
-                        allowedNames(enumTable(E{})));
+    problems_.push_back(where + ": value '" + text + "' is not allowed; allowed: " + allowedNames(enumTable(E{})));
   }
 
   YAML::Node node_;

@@ -37,16 +37,14 @@ void VerletPasses::kick(int count, double half_dt, const double* __restrict acce
   for (int i = 0; i < count; ++i) velocity[i] += half_dt * acceleration[i];
 }
 
-double VelocityVerlet::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
-                           double dt) {
+double VelocityVerlet::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t, double dt) {
   VerletPasses passes(u, v, a, dt);
   // Midpoint rule: the half-step velocity is the step's mean velocity.
   power = dynamics.accelerationInStrips(u, v, t + dt, a, passes);
   return power * dt;
 }
 
-double RungeKutta4::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t,
-                         double dt) {
+double RungeKutta4::step(Dynamics& dynamics, Vector& u, Vector& v, Vector& a, double& power, double t, double dt) {
   static constexpr double kStageShift[4] = {0.0, 0.5, 0.5, 1.0};
   static constexpr double kWeight[4] = {1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0};
   k_u_[0] = v;

@@ -77,7 +77,8 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
   if (method == StaticMethod::kMultigrid) {
     // Not make_unique: it would pass the matrix on by reference, and Eigen 3.4's sparse matrices,
     // having no move constructor, would be copied (360 MB at 10⁶ nodes).
-    multigrid_.reset(new GridMultigrid(freeStiffness(model, lifted_nodes, position_in_free, free_count, false), free_dofs_, layout));
+    multigrid_.reset(
+        new GridMultigrid(freeStiffness(model, lifted_nodes, position_in_free, free_count, false), free_dofs_, layout));
     return;
   }
   const SparseMatrix reduced = freeStiffness(model, lifted_nodes, position_in_free, free_count, true);
