@@ -330,9 +330,10 @@ void RigSimulator::pace() {
   if (ahead > 1e-3) ros::WallDuration(ahead).sleep();
 }
 
-void RigSimulator::run() {
+void RigSimulator::run() { finish(runUntilTheEnd()); }
+
+std::string RigSimulator::runUntilTheEnd() {
   ros::WallTime next_spin = ros::WallTime::now();
-  std::string end_reason;
   while (!stop_ && !g_stop_requested && ros::ok()) {
     const ros::WallTime now = ros::WallTime::now();
     if (now >= next_spin || paused_) {
@@ -355,21 +356,21 @@ void RigSimulator::run() {
     driver_->advance();
     publishLiveSnapshot();
     if (driver_->finished()) {
-      end_reason = simulation().stopReason();
-      ROS_INFO_STREAM("run ended: " << end_reason);
-      break;
+      ROS_INFO_STREAM("run ended: " << simulation().stopReason());
+      return simulation().stopReason();
     }
     pace();
   }
-  if (end_reason.empty()) {
-    std::ostringstream reason;
-    reason << (aborted_           ? "aborted by the abort service"
-               : stop_            ? "stopped by the stop service"
-               : g_stop_requested ? "interrupted by a signal"
-                                  : "ROS shut down")
-           << " at t = " << simulation().time() << " s";
-    end_reason = reason.str();
-  }
+  std::ostringstream reason;
+  reason << (aborted_           ? "aborted by the abort service"
+             : stop_            ? "stopped by the stop service"
+             : g_stop_requested ? "interrupted by a signal"
+                                : "ROS shut down")
+         << " at t = " << simulation().time() << " s";
+  return reason.str();
+}
+
+void RigSimulator::finish(const std::string& end_reason) {
   publishStageState();
   // The summary is the run since the last reset: its simulated time and steps start there, and its wall
   // time is the time spent running since, not waiting paused (for a controller, or a user).

@@ -123,6 +123,10 @@ class RigSimulator {
   bool aborted() const { return aborted_; }
 
  private:
+  /// Spins, pauses, resets, advances and paces until the run ends; returns why it ended.
+  std::string runUntilTheEnd();
+  /// The stage state, the summary and the bag at the end of the run.
+  void finish(const std::string& end_reason);
   void advertise();
   void startSimulation();
   /// The scene as it runs now (its stop condition set_run_end's, if called) on `scene` and in the bag.
