@@ -69,30 +69,38 @@ ProtocolReading readProtocolFields(const YAML::Node& root, LoadingProtocol& prot
   return reading;
 }
 
+/// Reports a protocol field's value out of its range: (field, value, what is allowed).
+using ProtocolProblem = std::function<void(const std::string&, double, const std::string&)>;
+
+/// Reports every value of step `i` of `protocol` out of its range.
+void checkProtocolStep(const LoadingProtocol& protocol, std::size_t i, const ProtocolProblem& problem) {
+  const ProtocolStep& step = protocol.steps[i];
+  const std::string where = "steps[" + std::to_string(i) + "]";
+  if (step.action == ProtocolAction::NormalLoad) {
+    if (!(step.normal_force > 0.0) || !std::isfinite(step.normal_force))
+      problem(where + ".normal_force", step.normal_force, "a finite F_Z > 0 N");
+    if (!(step.ramp_time >= 0.0) || !std::isfinite(step.ramp_time))
+      problem(where + ".ramp_time", step.ramp_time, "a finite time >= 0 s");
+    return;
+  }
+  if (!(step.duration > 0.0)) problem(where + ".duration", step.duration, "a duration > 0 s (.inf allowed)");
+  if (!std::isfinite(step.speed)) problem(where + ".speed", step.speed, "a finite speed in m/s");
+  if (step.action == ProtocolAction::MoveTo && !(step.speed > 0.0))
+    problem(where + ".speed", step.speed, "a travel speed > 0 m/s");
+  if (std::isinf(step.duration) && i + 1 < protocol.steps.size()) {
+    problem(where + ".duration", step.duration, "a finite duration: later steps would never run");
+  }
+}
+
 /// Adds to `problems` every value of the protocol out of its range.
 void checkProtocolValues(const LoadingProtocol& protocol, const ProtocolReading& reading,
                          std::vector<std::string>& problems) {
-  auto problem = [&](const std::string& field, double value, const std::string& allowed) {
+  const ProtocolProblem problem = [&](const std::string& field, double value, const std::string& allowed) {
     if (!reading.missing.count(field)) requireSetting(false, field, value, allowed, problems);
   };
   for (std::size_t i = 0; i < protocol.steps.size(); ++i) {
-    const ProtocolStep& step = protocol.steps[i];
     if (i < reading.action_refused.size() && reading.action_refused[i]) continue;
-    const std::string where = "steps[" + std::to_string(i) + "]";
-    if (step.action == ProtocolAction::NormalLoad) {
-      if (!(step.normal_force > 0.0) || !std::isfinite(step.normal_force))
-        problem(where + ".normal_force", step.normal_force, "a finite F_Z > 0 N");
-      if (!(step.ramp_time >= 0.0) || !std::isfinite(step.ramp_time))
-        problem(where + ".ramp_time", step.ramp_time, "a finite time >= 0 s");
-      continue;
-    }
-    if (!(step.duration > 0.0)) problem(where + ".duration", step.duration, "a duration > 0 s (.inf allowed)");
-    if (!std::isfinite(step.speed)) problem(where + ".speed", step.speed, "a finite speed in m/s");
-    if (step.action == ProtocolAction::MoveTo && !(step.speed > 0.0))
-      problem(where + ".speed", step.speed, "a travel speed > 0 m/s");
-    if (std::isinf(step.duration) && i + 1 < protocol.steps.size()) {
-      problem(where + ".duration", step.duration, "a finite duration: later steps would never run");
-    }
+    checkProtocolStep(protocol, i, problem);
   }
   if (protocol.end.global_events < 0) problem("end.global_events", protocol.end.global_events, "a count >= 0");
   if (!(protocol.end.stage_travel > 0.0)) problem("end.stage_travel", protocol.end.stage_travel, "a travel > 0 m");
@@ -228,6 +236,21 @@ std::vector<std::string> splitCsvLine(const std::string& line) {
   return cells;
 }
 
+/// Reads a command table row's time (cell 0) into `command`: a finite time >= 0 s, not before the row
+/// `before` (the last row read whose time was good, or null). Reports a problem and returns false if it
+/// cannot be read.
+bool readCommandTime(const std::string& cell, const TimedCommand* before, TimedCommand& command,
+                     const std::function<void(const std::string&)>& problem) {
+  if (!readStampSeconds(cell, command.time) || !std::isfinite(command.time) || command.time < 0.0) {
+    problem("time_s '" + cell + "' is not allowed; allowed: a finite time >= 0 s");
+    return false;
+  }
+  if (before && command.time < before->time) {
+    problem("time_s " + cell + " is earlier than the row before; allowed: rows in time order");
+  }
+  return true;
+}
+
 /// Reads a command table row's command and the fields it takes (cells 1 to 4) into `command`, reporting
 /// each problem; false if the command is unknown.
 bool readCommandFields(const std::vector<std::string>& cells, TimedCommand& command,
@@ -297,12 +320,7 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
     const std::size_t problems_before_row = problems.size();
     // A row whose time is refused is left out, so that the next is compared with the last good one.
     const bool time_readable =
-        readStampSeconds(cells[0], command.time) && std::isfinite(command.time) && command.time >= 0.0;
-    if (!time_readable) {
-      problem("time_s '" + cells[0] + "' is not allowed; allowed: a finite time >= 0 s");
-    } else if (!commands.empty() && command.time < commands.back().time) {
-      problem("time_s " + cells[0] + " is earlier than the row before; allowed: rows in time order");
-    }
+        readCommandTime(cells[0], commands.empty() ? nullptr : &commands.back(), command, problem);
     if (!readCommandFields(cells, command, problem)) continue;
     // What the run would refuse, for a row that is well formed: listed with the table's own problems.
     if (check && problems.size() == problems_before_row) {
