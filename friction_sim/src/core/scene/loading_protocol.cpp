@@ -286,6 +286,31 @@ bool readCommandFields(const std::vector<std::string>& cells, TimedCommand& comm
   return true;
 }
 
+/// Reads one row of a command table into `command`, reporting each problem, and what the run would
+/// refuse of a well-formed command (`check`, if given). True if the row joins the table: a row whose time
+/// is refused is left out, so that the next is compared with the last good one (`before`).
+bool readCommandRow(const std::string& line, const TimedCommand* before, const CommandCheck& check,
+                    const std::function<void(const std::string&)>& problem, TimedCommand& command) {
+  const std::vector<std::string> cells = splitCsvLine(line);
+  if (cells.size() != 5) {
+    problem("5 fields expected (time_s, command, speed_m_s, target_m, normal_force_N), got " +
+            std::to_string(cells.size()) + " in '" + line + "'");
+    return false;
+  }
+  int problems = 0;
+  const std::function<void(const std::string&)> counted = [&](const std::string& what) {
+    ++problems;
+    problem(what);
+  };
+  const bool time_readable = readCommandTime(cells[0], before, command, counted);
+  if (!readCommandFields(cells, command, counted)) return false;
+  if (check && problems == 0) {
+    const std::string refusal = check(command);
+    if (!refusal.empty()) problem(refusal);
+  }
+  return time_readable;
+}
+
 }  // namespace
 
 std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source,
@@ -299,35 +324,22 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
   auto problem = [&](const std::string& what) {
     problems.push_back(where_prefix + std::to_string(line_number) + ": " + what);
   };
-  bool header_seen = false;
-  while (std::getline(text, line)) {
+  auto next_line = [&] {
+    if (!std::getline(text, line)) return false;
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (!header_seen) {
-      header_seen = true;
-      if (line != kCommandTableHeader)
-        problem("the header must be '" + std::string(kCommandTableHeader) + "', got '" + line + "'");
-      continue;
-    }
+    return true;
+  };
+  const bool header_seen = next_line();
+  if (header_seen && line != kCommandTableHeader) {
+    problem("the header must be '" + std::string(kCommandTableHeader) + "', got '" + line + "'");
+  }
+  while (next_line()) {
     if (line.empty()) continue;
-    const std::vector<std::string> cells = splitCsvLine(line);
-    if (cells.size() != 5) {
-      problem("5 fields expected (time_s, command, speed_m_s, target_m, normal_force_N), got " +
-              std::to_string(cells.size()) + " in '" + line + "'");
-      continue;
-    }
     TimedCommand command;
-    const std::size_t problems_before_row = problems.size();
-    // A row whose time is refused is left out, so that the next is compared with the last good one.
-    const bool time_readable =
-        readCommandTime(cells[0], commands.empty() ? nullptr : &commands.back(), command, problem);
-    if (!readCommandFields(cells, command, problem)) continue;
-    // What the run would refuse, for a row that is well formed: listed with the table's own problems.
-    if (check && problems.size() == problems_before_row) {
-      const std::string refusal = check(command);
-      if (!refusal.empty()) problem(refusal);
+    if (readCommandRow(line, commands.empty() ? nullptr : &commands.back(), check, problem, command)) {
+      commands.push_back(command);
     }
-    if (time_readable) commands.push_back(command);
   }
   if (!header_seen)
     problems.push_back(where_prefix + "1: empty; a command table starts with its header '" +
