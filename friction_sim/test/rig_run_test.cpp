@@ -335,8 +335,7 @@ TEST(FullRun, TopicsHaveTheirTypesAndSimulatedTimeStamps) {
 
 TEST(FullRun, StageTravelFollowsThePositionAcrossFastForwardJumps) {
   // The protocol holds, then drives forward only: travel is the distance from the start, also in the
-  // stage states interpolated across a jump (they read the travel at the jump's end; found by a
-  // new-user walkthrough).
+  // stage states interpolated across a jump (not the travel at the jump's end).
   const auto states = readTopic<friction_msgs::StageState>(g_bag, "/rig/stage_state");
   ASSERT_GT(states.size(), 50u);  // 1 kHz over 55 ms
   for (const auto& state : states) {

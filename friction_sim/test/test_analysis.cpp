@@ -28,7 +28,7 @@ TEST(LoadingProtocol, RampHoldDriveBecomesATimedSchedule) {
   const auto whole = scheduleProtocol(protocol, 1.0, 1000.0);
   ASSERT_EQ(whole.size(), 1u + 4u + 3u);
   // The stage holds from the start while F_Z ramps: the protocol drives it, not the scene's program
-  // (which had driven it through stop_and_go's ramp; found by a new-user walkthrough).
+  // (which had driven it through stop_and_go's ramp).
   EXPECT_EQ(whole[0].kind, TimedCommand::Kind::Stage);
   EXPECT_EQ(whole[0].stage.mode, StageMode::Hold);
   EXPECT_DOUBLE_EQ(whole[0].time, 1.0);
@@ -81,7 +81,7 @@ TEST(LoadingProtocol, BadProtocolListsEveryProblem) {
 
 TEST(LoadingProtocol, WhatAStepActsWithAndAnEndMustBeGiven) {
   // A move_to without its target drove the stage back to 0, and a protocol without an end ran (and
-  // recorded) until stopped (found by a new-user walkthrough). Each missing field is named once, not
+  // recorded) until stopped. Each missing field is named once, not
   // also by its default's value.
   expectProtocolRefused(
       "steps:\n"
@@ -453,7 +453,7 @@ TEST(SlipEvents, ASliderSlidingAsAWholeWithItsTrailingCornerLiftedSlipsGlobally)
   // F_Z = 100 N pressing a slider pushed at its top edge: the trailing third of the interface lifts off
   // the track and stays off. Every node in contact slips in the stick-slip cycles: global events, which
   // end the run (before, a lifted node's missing slip made none global: 129 events in 0.05 s and no
-  // µ_s,macro; found by a review). The camera's detector agrees.
+  // µ_s,macro). The camera's detector agrees.
   Scene scene = testing::coarseSliderScene(false);
   scene.load.normal_force = 100.0;
   scene.pusher.height = 0.075;
@@ -483,8 +483,8 @@ TEST(SlipEvents, ASliderSlidingAsAWholeWithItsTrailingCornerLiftedSlipsGlobally)
 
 TEST(FrameEventDetector, AnEventWaitingForItsLastReadingIsGivenWhenTheStreamRestarts) {
   // A run's last event ends on its last frame; the load cell of that step, on its own topic, may come
-  // after a looped bag has started over (the event was lost on every pass; found by a new-user
-  // walkthrough). Without that reading it waits; told that no more come, it is given from the rest.
+  // after a looped bag has started over. Without that reading it waits; told that no more come, it is
+  // given from the rest.
   Simulation simulation(loadScene(testing::scenePath("single_block")));
   const Scene& scene = simulation.scene();
   FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal, scene.geometry.length);

@@ -153,7 +153,7 @@ TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
   EXPECT_NE(checkCommand(msg, simulation).find("normal load -10 N"), std::string::npos);
   msg.normal_force = std::numeric_limits<double>::infinity();
   EXPECT_NE(checkCommand(msg, simulation).find("finite F_Z"), std::string::npos);
-  // Beyond a small strain (found by a new-user walkthrough: 10⁹ N was accepted and the run went NaN).
+  // Beyond a small strain (10⁹ N was accepted and the run went NaN).
   msg.normal_force = 1e9;
   const double largest = largestNormalForce(simulation.scene());
   EXPECT_NE(checkCommand(msg, simulation).find("at most " + std::to_string(static_cast<int>(largest)) + " N"),

@@ -82,7 +82,7 @@ TEST(FastForward, InstrumentsInterpolatedAcrossAJumpReadWhatAJumpCutThereGives) 
 TEST(FastForward, AHoldCommandedWhileAThresholdIsApproachedJumpsAgain) {
   // Near a threshold the dynamics takes the approach over; a hold commanded then never brings the
   // crossing, and the slider, at rest where it stands, jumps again (it had stepped dynamically for the
-  // whole hold: 54 713 steps in 20 ms, found by a review).
+  // whole hold: 54 713 steps in 20 ms).
   Simulation simulation(testing::coarseSliderScene(true));
   while (simulation.mayJump() || simulation.jumps() == 0) simulation.advance(1.0);
   ASSERT_TRUE(simulation.quasiStatic());
@@ -95,7 +95,7 @@ TEST(FastForward, AHoldCommandedWhileAThresholdIsApproachedJumpsAgain) {
   EXPECT_LT(simulation.steps() - steps, 10);
   EXPECT_TRUE(simulation.events().empty());
   // Driven back, then forward again at the approach's speed: the approach is over, and the slider jumps
-  // back towards the threshold rather than stepping all the way (found by a review).
+  // back towards the threshold rather than stepping all the way.
   simulation.stage().command(StageCommand{StageMode::Velocity, -4e-3, 0.0});
   simulation.advance(simulation.time() + 0.002);
   simulation.stage().command(StageCommand{StageMode::Velocity, 4e-3, 0.0});
@@ -107,7 +107,7 @@ TEST(FastForward, AHoldCommandedWhileAThresholdIsApproachedJumpsAgain) {
 
 TEST(FastForward, AStageAtRestWithNoEndTakesNoEndlessJump) {
   // Held, with nothing due and no time limit, a jump would have no end: it is not taken (it went to
-  // t = inf and left NaN, found by a review); one with an end is.
+  // t = inf and left NaN); one with an end is.
   Scene scene = testing::coarseSliderScene(true);
   scene.stage.program = {StageSegment{StageMode::Hold, 0.0}};
   Simulation simulation(scene);

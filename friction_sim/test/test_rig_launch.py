@@ -137,7 +137,7 @@ class RigLaunchStatusTest(unittest.TestCase):
 
     def test_a_stage_held_without_end_runs_on_and_stops_when_interrupted(self):
         # Unpaced, a held stage with nothing due and no end time jumped to t = inf, and the simulator
-        # published forever without hearing the signal (found by a review).
+        # published forever without hearing the signal.
         work = tempfile.mkdtemp(prefix="rig_launch_test_")
         self.addCleanup(shutil.rmtree, work)
         protocol = os.path.join(work, "held.yaml")

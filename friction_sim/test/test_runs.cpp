@@ -210,7 +210,7 @@ TEST_F(SideDrivenChain, EnergyBudgetCloses) {
 
 TEST(EnergyBudget, HasNoRelativeResidualWhereNoEnergyChangedHands) {
   // A stage held from the start: every term of the budget is round-off of the stored energy, and their
-  // ratio (−0.13, found by a new-user walkthrough) is no residual.
+  // ratio (−0.13) is no residual.
   Scene scene = testing::coarseSliderScene(true);
   scene.stage.program = {StageSegment{StageMode::Hold, 0.0}};
   scene.stop.time = 0.01;

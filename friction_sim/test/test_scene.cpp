@@ -72,7 +72,7 @@ TEST(SceneFiles, OverridesAreParsedAndValidatedLikeTheFile) {
   EXPECT_DOUBLE_EQ(changed.pusher.height, 0.01);
   EXPECT_DOUBLE_EQ(changed.friction.kinetic_coefficient, 0.2);
   EXPECT_THROW(overrideScene(base, {{"pusher.hieght", "0.01"}}), SceneError);
-  // A list is replaced whole, which the refusal of one element says (found by a new-user walkthrough).
+  // A list is replaced whole, which the refusal of one element says.
   try {
     overrideScene(base, {{"stage.program[0].speed", "4e-3"}});
     ADD_FAILURE() << "accepted";
@@ -111,7 +111,7 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"material: {density: -1200}", "material.density: value -1200", "> 0"},
         InvalidCase{"pusher: {stiffness: 0}", "pusher.stiffness: value 0", "> 0"},
         InvalidCase{"lattice: {nodes_x: 57, nodes_z: 30}", "lattice.nodes_z: value 30", "square lattice"},
-        // With the sizes that fit the geometry (found by a new-user walkthrough: which field to change?).
+        // With the sizes that fit the geometry (which field to change?).
         InvalidCase{"lattice: {nodes_x: 50}", "lattice.nodes_z: value 31",
                     "sizes that fit 0.14 m x 0.075 m: nodes_x - 1 a multiple of 28, e.g. nodes_x: 57, nodes_z: 31"},
         InvalidCase{"instruments: {gauge_height: 0.1}", "instruments.gauge_height: value 0.1", "inside the slider"},
@@ -128,7 +128,7 @@ INSTANTIATE_TEST_SUITE_P(
                     "a finite number >= 0"},
         InvalidCase{"frictoin: {law: amontons_coulomb}", "frictoin: unknown key", "allowed keys here"},
         InvalidCase{"friction: {mu_s: 0.4}", "friction.mu_s: unknown key", "static_coefficient"},
-        // The first of two would have won without a word (found by a new-user walkthrough).
+        // The first of two would have won without a word.
         InvalidCase{"geometry:\n  length: 0.14\n  length: 0.2", "geometry.length: given more than once",
                     "give it once"},
         InvalidCase{"friction: {law: coulomb}", "friction.law: value 'coulomb'", "amontons_coulomb | slip_weakening"},
@@ -140,7 +140,7 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [3.0, 2.0, 1.0]}\n"
                     "friction: {interfacial_stiffness: 1.0e8}",
                     "friction.interfacial_stiffness: value 100000000", "0 (rigid sticking) with a chain.initial_shear"},
-        // A segment without an end before another (found by a new-user walkthrough).
+        // A segment without an end before another.
         InvalidCase{"stage: {program: [{mode: velocity, speed: 4.0e-4}, {mode: hold}]}",
                     "stage.program[0].duration: value inf", "a finite duration > 0 s: later segments would never run"},
         // 10⁶ N on pmma_2d compressed it by 40 %, folded the lattice and filled the run with NaN.

@@ -77,7 +77,7 @@ void PrecursorDetector::onScene(const std_msgs::String::ConstPtr& msg) {
   // A scene the detector measures the same with goes on with the analysis: the rig publishes its scene
   // again with a new run end, and a looped bag starts its next pass with its first scene, ahead of the
   // last frames of this pass (the time jumping back starts the analysis over once they are in; a new
-  // detector here lost the last event on every pass, found by a new-user walkthrough).
+  // detector here would lose the last event on every pass).
   if (settings.sameAs(settings_)) return;
   // A new detector otherwise: what the old one saw was measured against another scene, or none. The
   // scene is its bag's first message, but it travels apart from the frames, which may come first.
