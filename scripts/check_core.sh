@@ -35,6 +35,7 @@ slow=(
 )
 filter="-$(IFS=:; echo "${slow[*]}")"
 # -O1 with line tables: a quick build, and reports that name the line.
+mkdir -p "$build"
 cmake -S "$root/friction_sim" -B "$build" -DFRICTION_SIM_CORE_ONLY=ON -DFRICTION_SIM_SANITIZE=ON \
   -DFRICTION_WERROR=ON -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_FLAGS="-O1 -g1" >"$build.log" 2>&1 &&
   cmake --build "$build" -j2 >>"$build.log" 2>&1 || {
