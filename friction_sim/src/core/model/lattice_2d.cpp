@@ -171,7 +171,7 @@ class Lattice2D::Sweep {
 
   /// The hot kernel, kept whole (68 lines, over the project's 60): it runs for every row of every step,
   /// and its bonds, gathers and external forces share the row's pointers.
-  void sweepRow() {
+  void sweepRow() {  // NOLINT(readability-function-size): the hot kernel, kept whole (above)
     const Lattice2D& l = lattice_;
     const int nx = l.nx_, nz = l.nz_, n = l.n_, j = row_;
     const int prepared_end = preparedRowsForNextRow();

@@ -29,14 +29,14 @@ int Model::evaluateSuccessiveInStrips(int strip_nodes,
 }
 
 std::vector<double> Model::interfacePositions() const {
-  std::vector<double> positions;
-  for (int node = 0; node < interfaceNodeCount(); ++node) positions.push_back(interfacePosition(node));
+  std::vector<double> positions(interfaceNodeCount());
+  for (int node = 0; node < interfaceNodeCount(); ++node) positions[node] = interfacePosition(node);
   return positions;
 }
 
 std::vector<int> Model::blockedDofsDuringLoading() const {
-  std::vector<int> dofs;
-  for (int node = 0; node < interfaceNodeCount(); ++node) dofs.push_back(interfaceDof(node));
+  std::vector<int> dofs(interfaceNodeCount());
+  for (int node = 0; node < interfaceNodeCount(); ++node) dofs[node] = interfaceDof(node);
   return dofs;
 }
 
