@@ -183,8 +183,11 @@ int run(int argc, char** argv) {
   for (const friction::TimedCommand& command : commands) driver.schedule(command);
   int applied_commands = 0;
   driver.onCommandDue([&](const friction::TimedCommand& command, const std::string& refusal) {
-    if (refusal.empty()) ++applied_commands;
-    if (!refusal.empty()) std::cerr << "warning: command at t = " << command.time << " s refused: " << refusal << "\n";
+    if (refusal.empty()) {
+      ++applied_commands;
+    } else {
+      std::cerr << "warning: command at t = " << command.time << " s refused: " << refusal << "\n";
+    }
   });
   std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
   addStreams(driver, loading, stresses_csv);

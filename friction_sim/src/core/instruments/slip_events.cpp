@@ -23,11 +23,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed,
                                      double slider_length)
-    : fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed), slider_length_(slider_length) {
-  for (int node = 0; node < model.interfaceNodeCount(); ++node) {
-    positions_.push_back(model.interfacePosition(node));
-    dofs_.push_back(model.interfaceDof(node));
-  }
+    : positions_(model.interfacePositions()),
+      fit_nodes_(front_fit_nodes),
+      longitudinal_speed_(longitudinal_speed),
+      slider_length_(slider_length) {
+  for (int node = 0; node < model.interfaceNodeCount(); ++node) dofs_.push_back(model.interfaceDof(node));
   onset_u_.resize(positions_.size());
 }
 
