@@ -8,6 +8,7 @@
 
 #include "friction_sim/instruments/instruments.h"
 #include "friction_sim/instruments/slip_events.h"
+#include "friction_sim/run/run_driver.h"
 #include "friction_sim/run/simulation.h"
 
 namespace friction {
@@ -53,5 +54,14 @@ void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& read
 void writeStressesHeader(std::ostream& out);
 void writeStressRows(std::ostream& out, int event, const char* phase, const InterfaceFrame& frame,
                      const GaugeProfile& gauges);
+/// A stream that writes stresses.csv as the run goes, its header first: at each event's onset the loaded
+/// state that gave way, at its end the state then; `ended`, if given, is called after the end's rows.
+std::unique_ptr<EventStream> stressesStream(std::ostream& out, EventStream::Ended ended = nullptr);
+
+/// The result folder's files written at a run's end, in `out_dir`: events.csv, event_nodes.csv,
+/// loading.csv, scene.yaml (the scene as run) and summary.txt, the summary also printed to `console`.
+/// False if one could not be written in full.
+bool writeRunEndFiles(const std::string& out_dir, const Simulation& simulation,
+                      const std::vector<LoadCellReading>& loading, double wall_time, std::ostream& console);
 
 }  // namespace friction

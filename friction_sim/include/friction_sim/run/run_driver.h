@@ -16,6 +16,7 @@
 #include "friction_sim/instruments/instruments.h"
 #include "friction_sim/run/command_schedule.h"
 #include "friction_sim/run/simulation.h"
+#include "friction_sim/scene/loading_protocol.h"
 
 namespace friction {
 
@@ -186,6 +187,12 @@ class RunDriver {
   /// Schedules a command at its time (check it first with Simulation::checkCommand): what the simulation
   /// refuses it for when it is due is reported then.
   void schedule(const TimedCommand& command) { schedule_.add(command); }
+  /// Schedules every command of a command table (rig_report's stage_commands.csv) read from `path`, each
+  /// checked against the simulation first: throws ConfigError listing every problem. Returns how many.
+  std::size_t scheduleCommandTable(const std::string& path);
+  /// Schedules a loading protocol's commands as the stage controller sends them from t = 0, each step
+  /// checked first (ConfigError names `path`). Its end is the caller's: it is part of the scene run.
+  std::size_t scheduleProtocol(const LoadingProtocol& protocol, const std::string& path);
   /// Replaces the scene's stop condition (Simulation::setStopCondition) and ends the run when it holds,
   /// whatever stop_at_scene_end. Returns the refusal, or empty.
   std::string setRunEnd(const StopSpec& stop);

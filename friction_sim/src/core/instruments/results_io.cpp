@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <iomanip>
 #include <limits>
+
+#include "friction_sim/scene/scene_io.h"
 
 namespace friction {
 
@@ -120,6 +123,37 @@ void writeStressRows(std::ostream& out, int event, const char* phase, const Inte
         << (gauge ? gauges.stress.tau_xz[i] : NAN) << ',' << frame.normal_stress[i] << ',' << frame.shear_stress[i]
         << '\n';
   }
+}
+
+std::unique_ptr<EventStream> stressesStream(std::ostream& out, EventStream::Ended ended) {
+  writeStressesHeader(out);
+  return std::make_unique<EventStream>(
+      [&out](const Simulation& s) {
+        // The nodes that unstuck in the onset step, at their thresholds.
+        const int event = static_cast<int>(s.events().size());
+        writeStressRows(out, event, "onset", s.interfaceFrameBeforeUnsticking(), s.gaugeProfile());
+      },
+      [&out, ended](const Simulation& s, const SlipEvent& event) {
+        writeStressRows(out, event.index, "end", s.interfaceFrame(), s.gaugeProfile());
+        if (ended) ended(s, event);
+      });
+}
+
+bool writeRunEndFiles(const std::string& out_dir, const Simulation& simulation,
+                      const std::vector<LoadCellReading>& loading, double wall_time, std::ostream& console) {
+  std::ofstream events_csv(out_dir + "/events.csv"), nodes_csv(out_dir + "/event_nodes.csv"),
+      loading_csv(out_dir + "/loading.csv"), scene_yaml(out_dir + "/scene.yaml"), summary_txt(out_dir + "/summary.txt");
+  writeEventsCsv(events_csv, simulation.events(), simulation.scene());
+  writeEventNodesCsv(nodes_csv, simulation.events(), simulation.model().interfacePositions());
+  writeLoadingCsv(loading_csv, loading);
+  scene_yaml << sceneToYaml(simulation.scene());
+  const RunSummary summary = summarize(simulation, wall_time);
+  printSummary(summary_txt, summary);
+  printSummary(console, summary);
+  for (std::ofstream* file : {&events_csv, &nodes_csv, &loading_csv, &scene_yaml, &summary_txt}) {
+    if (!file->flush()) return false;
+  }
+  return true;
 }
 
 }  // namespace friction

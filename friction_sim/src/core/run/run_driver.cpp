@@ -37,6 +37,20 @@ std::string RunDriver::setRunEnd(const StopSpec& stop) {
   return refusal;
 }
 
+std::size_t RunDriver::scheduleCommandTable(const std::string& path) {
+  const auto commands =
+      loadCommandTable(path, [this](const TimedCommand& command) { return simulation_.checkCommand(command); });
+  for (const TimedCommand& command : commands) schedule(command);
+  return commands.size();
+}
+
+std::size_t RunDriver::scheduleProtocol(const LoadingProtocol& protocol, const std::string& path) {
+  checkProtocolSteps(protocol, path, [this](const TimedCommand& command) { return simulation_.checkCommand(command); });
+  const auto commands = protocolCommands(protocol, simulation_.scene().load.normal_force);
+  for (const TimedCommand& command : commands) schedule(command);
+  return commands.size();
+}
+
 double RunDriver::jumpEnd() const {
   double end = schedule_.nextTime();
   // A rest with no end (the stage still, nothing due, no program segment to end) is cut at frames too,
