@@ -66,6 +66,7 @@ set(FRICTION_SIM_CORE_TESTS
   test/test_fast_forward.cpp
   test/test_hard_cases.cpp
   test/test_friction_laws.cpp
+  test/test_rate_state.cpp
   test/test_lattice.cpp
   test/test_scene.cpp
   test/test_static_solver.cpp

@@ -32,7 +32,7 @@ class OneNode : public ::testing::Test {
     contact_.lendNormalStorage(raw_.normal_force);
     raw_.normal_force = Vector::Constant(1, normal);
     Vector force = raw_.force;
-    contact_.applyFriction(raw_, u_, 1.0, force);
+    contact_.applyFriction(raw_, u_, v_, 1.0, force);
     return force[0];
   }
   /// The state update after a force evaluation giving `other` and `normal` (N).
@@ -78,7 +78,7 @@ TEST_F(OneNode, FrictionReappliedAfterUnstickingUsesTheLastNormalForce) {
   update(3.0, 8.0);  // an earlier update at another normal force
   EXPECT_TRUE(update(4.1, 10.0));
   Vector acceleration = Vector::Zero(1);
-  contact_.reapplyFriction(u_, 1.0, acceleration);
+  contact_.reapplyFriction(u_, v_, 1.0, acceleration);
   EXPECT_DOUBLE_EQ(acceleration[0], 4.1 - kMuK * 10.0);
   EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -kMuK * 10.0);
   EXPECT_DOUBLE_EQ(contact_.normalForce(0), 10.0);
@@ -292,7 +292,7 @@ TEST_F(OneNode, KeepsTheLastUpdatesNormalForceWhenTheNextEvaluationUsesOtherStor
   contact_.lendNormalStorage(other.normal_force);
   other.normal_force = Vector::Constant(1, 10.0);
   Vector force = other.force;
-  contact_.applyFriction(other, u_, 1.0, force);
+  contact_.applyFriction(other, u_, v_, 1.0, force);
   ASSERT_TRUE(contact_.updateStates(u_, v_, 1e-3, 1.0));
   const double before = 3.0 / (kMuS * 8.0), after = 4.1 / (kMuS * 10.0);
   EXPECT_DOUBLE_EQ(contact_.transitionFraction(0), (1.0 - before) / (after - before));
@@ -302,7 +302,7 @@ TEST_F(OneNode, RefusesNormalForcesRewrittenOverThoseOfTheLastUpdate) {
   update(3.0, 8.0);
   raw_.normal_force[0] = 10.0;  // in place: the 8 N the next update needs are lost
   Vector force = raw_.force;
-  EXPECT_THROW(contact_.applyFriction(raw_, u_, 1.0, force), std::logic_error);
+  EXPECT_THROW(contact_.applyFriction(raw_, u_, v_, 1.0, force), std::logic_error);
 }
 
 TEST_F(OneNode, NodeUnstuckAtTheEndOfAnAllStuckStepStartedWhereItWasBeforeItsCatchUp) {
@@ -386,7 +386,7 @@ TEST(ElasticAnchor, StuckNodeIsHeldByTheInterfacialSpringAndReSticksWithContinuo
     contact.lendNormalStorage(raw.normal_force);
     raw.normal_force = Vector::Constant(1, 10.0);
     force = raw.force;
-    contact.applyFriction(raw, u, inverse_mass, force);
+    contact.applyFriction(raw, u, v, inverse_mass, force);
   };
   u[0] = 3e-3;         // anchor spring force −3 N, within µ_s·N = 4 N
   applyFriction(0.5);  // a 2 kg block

@@ -44,6 +44,25 @@ TEST(SceneFiles, ShippedScenesLoadWithTheirNumbers) {
   EXPECT_EQ(loadScene(scenePath("pmma_1d_side")).chain.driving, ChainDriving::Side);
   EXPECT_EQ(loadScene(scenePath("pmma_1d_top")).chain.driving, ChainDriving::Top);
   EXPECT_EQ(loadScene(scenePath("single_block")).chain.blocks, 1);
+  for (const char* name : {"rate_state", "pmma_2d_rate_state"}) {
+    const FrictionSpec friction = loadScene(scenePath(name)).friction;
+    EXPECT_EQ(friction.law, FrictionLawKind::RateState);
+    EXPECT_DOUBLE_EQ(friction.rate_state.characteristic_slip, 0.5e-6);
+    EXPECT_DOUBLE_EQ(friction.rate_state.initial_age, 100.0);
+    // µ(0, 100 s) = f0·(1 + b·ln(1 + 100 s/φ*))
+    EXPECT_NEAR(friction.initialStaticCoefficient(), 0.285 * (1.0 + 0.075 * std::log1p(100.0 / 0.33e-3)), 1e-15);
+  }
+}
+
+TEST(SceneFiles, RateStateParametersAreRefusedOutsideTheirRangesAndWithRungeKutta) {
+  const auto problems = problemsOf(
+      "friction: {law: rate_state, characteristic_slip: 0, reference_speed: -1, initial_age: .inf, direct_effect: "
+      "-0.1}\nintegrator: {scheme: rk4, time_step: 1.0e-7}");
+  EXPECT_TRUE(mentions(problems, "friction.characteristic_slip: value 0 is not allowed"));
+  EXPECT_TRUE(mentions(problems, "friction.reference_speed: value -1"));
+  EXPECT_TRUE(mentions(problems, "friction.initial_age"));
+  EXPECT_TRUE(mentions(problems, "friction.direct_effect"));
+  EXPECT_TRUE(mentions(problems, "integrator.scheme: rk4 is not allowed with friction.law rate_state"));
 }
 
 TEST(SceneFiles, WrittenSceneReadsBackIdentically) {

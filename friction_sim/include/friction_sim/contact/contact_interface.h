@@ -41,16 +41,20 @@ class ContactInterface {
   /// entries of nodes [first_node, end_node) for the state updates, and rewrites those entries as
   /// accelerations (m/s²): (force + friction)·`inverse_mass`. The other entries are left to the caller.
   /// Nodes are independent here, so a caller may go range by range. `raw.normal_force` must stay
-  /// unchanged until the next evaluation (see lendNormalStorage).
-  void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force, int first_node,
-                     int end_node);
-  /// The same for every interface node.
-  void applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force) {
-    applyFriction(raw, u, inverse_mass, force, 0, size());
+  /// unchanged until the next evaluation (see lendNormalStorage). A rate-dependent law's sliding
+  /// friction is solved with the velocity the node ends the step with: `v` (m/s) is its velocity before
+  /// the step's closing kick of `closing_kick` (s, half the step; 0 outside a step, where `v` is final).
+  void applyFriction(const ForceEvaluation& raw, const Vector& u, const Vector& v, double inverse_mass, Vector& force,
+                     int first_node, int end_node, double closing_kick);
+  /// The same for every interface node, outside a step.
+  void applyFriction(const ForceEvaluation& raw, const Vector& u, const Vector& v, double inverse_mass, Vector& force) {
+    applyFriction(raw, u, v, inverse_mass, force, 0, size(), 0.0);
   }
   /// After a change of state: recomputes the friction from the recorded forces and rewrites the
   /// interface entries of `acceleration` (m/s²) as (other force + friction)·`inverse_mass`.
-  void reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration);
+  void reapplyFriction(const Vector& u, const Vector& v, double inverse_mass, Vector& acceleration);
+  /// s, the simulated time now: a law whose state evolves in time reads it. Set whenever the clock moves.
+  void setTime(double time) { law_->setTime(time); }
 
   /// Remembers the interface at the start of a step.
   void beginStep(const Vector& u, const Vector& v);
@@ -149,9 +153,19 @@ class ContactInterface {
   /// with accelerations (m/s²), (other force + friction)·`inverse_mass`.
   void accelerateWithFriction(const double* u, const double* normal, double inverse_mass, double* force_to_acceleration,
                               int first_node, int end_node);
+  /// For a rate-dependent law: the friction of the sliding nodes among [first_node, end_node), solved
+  /// with the velocity each ends the closing kick with (applyFriction), and their accelerations.
+  void solveSlidingFriction(const double* v, double closing_kick, double inverse_mass, double* force_to_acceleration,
+                            int first_node, int end_node);
+  /// For a law that ages: every stuck node's µ_s as of now.
+  void refreshStaticCoefficients();
 
   std::unique_ptr<FrictionLaw> law_;
   bool uniform_law_;  ///< law_->uniform(), asked once
+  // law_->ages() and law_->rateDependent(), asked once. With an ageing law µ_s grows while a node is
+  // stuck: the friction pass compares loads with µ_s as last read (never above its value now), and the
+  // state update reads it afresh before it decides.
+  bool ageing_law_, rate_dependent_law_;
   bool slip_changed_coefficients_ = false;
   std::vector<int> dofs_;
   int first_dof_;

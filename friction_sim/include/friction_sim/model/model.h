@@ -51,6 +51,8 @@ class StripHooks {
   /// Called once the forces on these degrees of freedom are final, and so are the normal forces of the
   /// interface nodes among them, and their velocities will not be read again (the closing kick).
   virtual void finish(int /*first*/, int /*end*/) {}
+  /// s, the step's closing kick that finish() gives the velocities (0: none; they are final).
+  virtual double closingKick() const { return 0.0; }
 };
 
 /// One force evaluation of Model::evaluateSuccessiveInStrips: the arguments of evaluateInStrips.

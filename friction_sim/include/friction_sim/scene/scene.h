@@ -6,6 +6,7 @@
 // The defaults are MODEL.md's `pmma_2d` table.
 #pragma once
 
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -21,7 +22,7 @@ enum class InterfaceLoading {
   Free,   ///< free in x (a lubricated placement): no shear stored; the nodes stick where the load left them
 };
 enum class ChainDriving { Side, Top };
-enum class FrictionLawKind { AmontonsCoulomb, SlipWeakening };
+enum class FrictionLawKind { AmontonsCoulomb, SlipWeakening, RateState };
 enum class IntegratorKind { VelocityVerlet, RungeKutta4 };
 enum class StageMode { Velocity, Hold, Position };
 
@@ -55,13 +56,44 @@ struct ChainSpec {
   std::vector<double> initial_shear;
 };
 
+/// Rate-and-state friction with the ageing law (friction.law rate_state, MODEL.md §4):
+/// µ(v, φ) = f0 + a·ln(1 + |v|/v*) + b·f0·ln(1 + φ/φ*), dφ/dt = 1 − |v|·φ/D. Defaults: PMMA.
+struct RateStateSpec {
+  double reference_coefficient = 0.285;  ///< f0, dimensionless
+  double direct_effect = 0.005;          ///< a, dimensionless: µ's rise per e-fold of slip speed
+  double ageing_effect = 0.075;          ///< b, dimensionless: b·f0 is µ's rise per e-fold of contact age
+  double characteristic_slip = 0.5e-6;   ///< m, D: the slip that renews the contacts
+  double reference_speed = 1.0e-7;       ///< m/s, v*
+  double reference_age = 0.33e-3;        ///< s, φ*
+  double initial_age = 100.0;            ///< s, φ of every contact when the run starts (F_Z applied)
+
+  /// µ at slip speed `speed` (m/s, ≥ 0) and contact age `age` (s).
+  double coefficient(double speed, double age) const {
+    return reference_coefficient + direct_effect * std::log1p(speed / reference_speed) +
+           ageing_effect * reference_coefficient * std::log1p(age / reference_age);
+  }
+  /// µ(0, φ): a stuck contact of age `age` (s) holds up to this times N.
+  double staticCoefficient(double age) const { return coefficient(0.0, age); }
+  /// ∂µ/∂v (s/m) at slip speed `speed`.
+  double speedSlope(double speed) const { return direct_effect / (reference_speed + speed); }
+  /// µ of steady sliding at `speed` (m/s, > 0): φ = D/speed.
+  double steadyStateCoefficient(double speed) const { return coefficient(speed, characteristic_slip / speed); }
+};
+
 struct FrictionSpec {
   FrictionLawKind law = FrictionLawKind::AmontonsCoulomb;  ///< the sliding resistance µ (MODEL.md §4)
-  double static_coefficient = 0.4;                         ///< µ_s, dimensionless: a stuck node holds up to µ_s·N
+  double static_coefficient = 0.4;    ///< µ_s, dimensionless: a stuck node holds up to µ_s·N (not rate_state)
   double kinetic_coefficient = 0.17;  ///< µ_k, dimensionless (≤ µ_s): sliding friction, after weakening
   double weakening_length = 0.0;      ///< m, ξ_µ of linear slip weakening (0 = Amontons–Coulomb)
+  RateStateSpec rate_state;           ///< the rate_state law's parameters
   /// N/m, k_T: a stuck node is held by this spring to its anchor; 0 = rigid stick constraint
   double interfacial_stiffness = 0.0;
+
+  /// µ_s at the start of the run: static_coefficient, or rate_state's µ(0, initial_age).
+  double initialStaticCoefficient() const {
+    return law == FrictionLawKind::RateState ? rate_state.staticCoefficient(rate_state.initial_age)
+                                             : static_coefficient;
+  }
 };
 
 struct LoadSpec {

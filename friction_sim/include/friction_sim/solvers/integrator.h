@@ -39,6 +39,7 @@ class VerletPasses : public StripHooks {
   VerletPasses(Vector& u, Vector& v, const Vector& a, double dt);
   void prepare(int first, int end) override;
   void finish(int first, int end) override;
+  double closingKick() const override { return half_dt_; }
 
  private:
   // Static, with restrict parameters: GCC honours restrict only on parameters.

@@ -13,7 +13,11 @@ constexpr double kStuckMode = 2.0;
 }  // namespace
 
 ContactInterface::ContactInterface(std::unique_ptr<FrictionLaw> law, const Model& model, double tangential_stiffness)
-    : law_(std::move(law)), uniform_law_(law_->uniform()), k_t_(tangential_stiffness) {
+    : law_(std::move(law)),
+      uniform_law_(law_->uniform()),
+      ageing_law_(law_->ages()),
+      rate_dependent_law_(law_->rateDependent()),
+      k_t_(tangential_stiffness) {
   const int n = model.interfaceNodeCount();
   for (int node = 0; node < n; ++node) dofs_.push_back(model.interfaceDof(node));
   first_dof_ = n > 0 ? dofs_[0] : 0;
@@ -149,19 +153,50 @@ void ContactInterface::accelerateWithFriction(const double* u, const double* nor
            friction_[current_slot_].data() + first_node, force_to_acceleration + offset);
 }
 
-void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, double inverse_mass, Vector& force,
-                                     int first_node, int end_node) {
+void ContactInterface::applyFriction(const ForceEvaluation& raw, const Vector& u, const Vector& v, double inverse_mass,
+                                     Vector& force, int first_node, int end_node, double closing_kick) {
   if (normals_to_take_ && raw.normal_force.data() == latest_normal_) {
     throw std::logic_error(
         "ContactInterface::applyFriction: normal forces evaluated over those of the last state update, which "
         "the next update needs; call lendNormalStorage before the evaluation");
   }
   accelerateWithFriction(u.data(), raw.normal_force.data(), inverse_mass, force.data(), first_node, end_node);
+  if (rate_dependent_law_ && sliding_count_ > 0) {
+    solveSlidingFriction(v.data(), closing_kick, inverse_mass, force.data(), first_node, end_node);
+  }
 }
 
-void ContactInterface::reapplyFriction(const Vector& u, double inverse_mass, Vector& acceleration) {
+void ContactInterface::reapplyFriction(const Vector& u, const Vector& v, double inverse_mass, Vector& acceleration) {
   std::copy_n(other_force_.data(), size(), acceleration.data() + first_dof_);
   accelerateWithFriction(u.data(), latest_normal_, inverse_mass, acceleration.data(), 0, size());
+  if (rate_dependent_law_ && sliding_count_ > 0) {
+    solveSlidingFriction(v.data(), 0.0, inverse_mass, acceleration.data(), 0, size());
+  }
+}
+
+void ContactInterface::solveSlidingFriction(const double* v, double closing_kick, double inverse_mass,
+                                            double* force_to_acceleration, int first_node, int end_node) {
+  // An explicit µ(v) at the kick's start would act as a damper of a·N/v* on the node: unstable at any
+  // usable step. The node's speed at the kick's end and its friction are solved together instead.
+  const double kick_per_force = closing_kick * inverse_mass;  // m/s per N
+  for (int node = first_node; node < end_node; ++node) {
+    if (state_[node] != ContactState::Sliding) continue;
+    const int dof = first_dof_ + node;
+    const double direction = friction_mode_[node];
+    const double normal = latest_normal_[node];
+    const double reach = direction * (v[dof] + kick_per_force * other_force_[node]);
+    const double speed = closing_kick > 0.0 ? law_->endSpeed(node, reach, kick_per_force * normal) : reach;
+    const double mu = law_->coefficientAt(node, std::max(speed, 0.0));
+    sliding_coefficient_[node] = mu;
+    friction_[current_slot_][node] = -mu * normal * direction;
+    force_to_acceleration[dof] = (other_force_[node] + friction_[current_slot_][node]) * inverse_mass;
+  }
+}
+
+void ContactInterface::refreshStaticCoefficients() {
+  for (int node = 0; node < size(); ++node) {
+    if (state_[node] == ContactState::Stuck) static_coefficient_[node] = law_->staticCoefficient(node);
+  }
 }
 
 void ContactInterface::beginStep(const Vector& u, const Vector& v) {
@@ -287,6 +322,7 @@ bool ContactInterface::updateStates(Vector& u, Vector& v, double dt, double node
     rotateLoads();
     return false;
   }
+  if (ageing_law_) refreshStaticCoefficients();
   bool changed = false;
   for (int node = 0; node < size(); ++node) {
     const double normal = latest_normal_[node];
@@ -319,6 +355,8 @@ void ContactInterface::regainContact(int node, const Vector& u, const Vector& v)
   // Contact returns as this update sees it, at the step's end; the fraction of its last transition is
   // stale.
   transition_fraction_[node] = 1.0;
+  law_->onLanding(node);
+  refreshCoefficients(node);
   const double velocity = v[dofs_[node]];
   if (velocity != 0.0) {
     startSliding(node, velocity > 0.0 ? 1 : -1);
@@ -364,7 +402,7 @@ bool ContactInterface::holdsPinned(const ForceEvaluation& trial) const {
     const double normal = trial.normal_force[node];
     if (state_[node] == ContactState::Detached) {
       if (normal > 0.0) return false;
-    } else if (normal <= 0.0 || std::abs(trial.force[dofs_[node]]) > static_coefficient_[node] * normal) {
+    } else if (normal <= 0.0 || std::abs(trial.force[dofs_[node]]) > law_->staticCoefficient(node) * normal) {
       return false;
     }
   }

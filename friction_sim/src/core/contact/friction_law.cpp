@@ -19,7 +19,58 @@ double LinearSlipWeakening::slidingCoefficient(int node) const {
 
 void LinearSlipWeakening::onSlip(int node, double slip) { slip_since_unstick_[node] += std::abs(slip); }
 
+void RateAndState::resize(int node_count) {
+  age_.assign(node_count, spec_.initial_age);
+  since_.assign(node_count, now_);
+}
+
+void RateAndState::settle(int node) {
+  age_[node] = age(node);
+  since_[node] = now_;
+}
+
+void RateAndState::onSlip(int node, double slip) {
+  // dφ/dt = 1 − vφ/D at the constant speed v = s/Δt: φ relaxes towards D/v as exp(−s/D).
+  const double elapsed = now_ - since_[node];
+  const double renewed = std::abs(slip) / spec_.characteristic_slip;
+  const double kept = std::exp(-renewed);
+  // Δt·(1 − e^(−x))/x, which is Δt as x → 0.
+  const double grown = renewed > 0.0 ? elapsed * -std::expm1(-renewed) / renewed : elapsed;
+  age_[node] = age_[node] * kept + grown;
+  since_[node] = now_;
+}
+
+double RateAndState::endSpeed(int node, double reach, double resistance) const {
+  const double at_rest = coefficientAt(node, 0.0);
+  const double fastest = reach - resistance * at_rest;
+  if (fastest <= 0.0) return fastest;
+  // In x = ln(1 + y/v*), y + resistance·µ(y) = reach reads v*(e^x − 1) + resistance·(µ(0) + a·x) = reach:
+  // convex and increasing in x, so Newton's method from above (the speed with µ(0)) converges monotonically.
+  const double v_star = spec_.reference_speed, a = spec_.direct_effect;
+  double x = std::log1p(fastest / v_star);
+  constexpr int kMaxIterations = 200;
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    const double excess = v_star * std::expm1(x) + resistance * (at_rest + a * x) - reach;
+    const double step = excess / (v_star * std::exp(x) + resistance * a);
+    if (!(step > 1e-15 * x)) break;
+    x -= step;
+  }
+  return v_star * std::expm1(x);
+}
+
+void RateAndState::onLanding(int node) {
+  age_[node] = 0.0;
+  since_[node] = now_;
+}
+
+std::vector<double> RateAndState::stateNumbers() const {
+  std::vector<double> numbers(age_.size());
+  for (std::size_t node = 0; node < age_.size(); ++node) numbers[node] = age(static_cast<int>(node));
+  return numbers;
+}
+
 std::unique_ptr<FrictionLaw> buildFrictionLaw(const FrictionSpec& spec) {
+  if (spec.law == FrictionLawKind::RateState) return std::make_unique<RateAndState>(spec.rate_state);
   if (spec.law == FrictionLawKind::SlipWeakening) {
     return std::make_unique<LinearSlipWeakening>(spec.static_coefficient, spec.kinetic_coefficient,
                                                  spec.weakening_length);

@@ -101,6 +101,9 @@ std::uint64_t Simulation::stateHash() const {
     const auto state = contact_.state(node);
     mix(&state, sizeof state);
   }
+  // A law's own state (a contact's age), for the laws that keep one.
+  const std::vector<double> law_state = contact_.law().stateNumbers();
+  mix(law_state.data(), sizeof(double) * law_state.size());
   for (const SlipEvent& event : events()) {
     const double numbers[] = {event.onset_time,       event.end_time,       event.onset_shear_force,
                               event.mean_shear_force, event.rupture_length, event.nucleation_position};

@@ -21,13 +21,14 @@ constexpr int kGroupStripNodes = 2048;
 class AccelerationStrips : public StripHooks {
  public:
   AccelerationStrips(StripHooks& caller, Vector& a, double inverse_mass, ContactInterface& contact,
-                     const ForceEvaluation& evaluation, const Vector& u)
+                     const ForceEvaluation& evaluation, const Vector& u, const Vector& v)
       : caller_(caller),
         a_(a),
         inverse_mass_(inverse_mass),
         contact_(contact),
         evaluation_(evaluation),
         u_(u),
+        v_(v),
         interface_begin_(contact.firstDof()),
         interface_end_(interface_begin_ + contact.size()) {}
   void prepare(int first, int end) override { caller_.prepare(first, end); }
@@ -35,7 +36,9 @@ class AccelerationStrips : public StripHooks {
     scaleOutsideInterface(first, std::min(end, interface_begin_));
     const int first_node = std::max(first, interface_begin_) - interface_begin_;
     const int end_node = std::min(end, interface_end_) - interface_begin_;
-    if (first_node < end_node) contact_.applyFriction(evaluation_, u_, inverse_mass_, a_, first_node, end_node);
+    if (first_node < end_node) {
+      contact_.applyFriction(evaluation_, u_, v_, inverse_mass_, a_, first_node, end_node, caller_.closingKick());
+    }
     scaleOutsideInterface(std::max(first, interface_end_), end);
     caller_.finish(first, end);
   }
@@ -51,6 +54,7 @@ class AccelerationStrips : public StripHooks {
   ContactInterface& contact_;
   const ForceEvaluation& evaluation_;
   const Vector& u_;
+  const Vector& v_;
   int interface_begin_, interface_end_;
 };
 

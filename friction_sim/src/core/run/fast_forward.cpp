@@ -172,10 +172,40 @@ void FastForward::findFirstCrossing(Path& path, const ForceEvaluation& here, con
     // Times t > 0 where ±F(t) = µ_s·N(t) or N(t) = 0.
     for (double sign : {1.0, -1.0}) {
       const double slope = sign * force_rate - mu * normal_rate;
-      if (slope > 0.0) stop_at((mu * normal - sign * force) / slope);
+      if (!(slope > 0.0)) continue;
+      const double crossing = (mu * normal - sign * force) / slope;
+      stop_at(contact.law().ages()
+                  ? agedCrossing(node, sign, force, force_rate, normal, normal_rate, crossing, path.length)
+                  : crossing);
     }
     if (normal_rate < 0.0) stop_at(-normal / normal_rate);
   }
+}
+
+double FastForward::agedCrossing(int node, double sign, double force, double force_rate, double normal,
+                                 double normal_rate, double earliest, double latest) const {
+  const FrictionLaw& law = sim_.contact_.law();
+  auto margin = [&](double t) {
+    return law.staticCoefficientAfter(node, t) * (normal + normal_rate * t) - sign * (force + force_rate * t);
+  };
+  // The strength rises as the logarithm of the age, the load linearly: the margin falls through zero once.
+  // Scanned in even parts, a crossing is bracketed, then halved down to round-off.
+  constexpr int kParts = 64;
+  double low = std::max(earliest, 0.0);
+  for (int part = 1; part <= kParts && low < latest; ++part) {
+    double high = low + (latest - low) / (kParts + 1 - part);
+    if (margin(high) >= 0.0) {
+      low = high;
+      continue;
+    }
+    while (high - low > 1e-15 * high) {
+      const double middle = 0.5 * (low + high);
+      if (middle <= low || middle >= high) break;
+      (margin(middle) >= 0.0 ? low : high) = middle;
+    }
+    return low;
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
@@ -187,6 +217,7 @@ void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   s.u_ += (stage_end - stage_start) * path.along;
   s.stage_.advance(jump);
   s.time_ = end_time;
+  s.contact_.setTime(end_time);
   const double kinetic_before = s.kineticEnergy();
   solver.solve(*s.model_, s.u_, stage_end);
   s.v_.swap(path.velocity);

@@ -87,12 +87,12 @@ double Simulation::acceleration(const Vector& u, const Vector& v, double t, Vect
 
 double Simulation::accelerationInStrips(const Vector& u, const Vector& v, double t, Vector& a, StripHooks& hooks) {
   contact_.lendNormalStorage(evaluation_.normal_force);
-  AccelerationStrips strips(hooks, a, inverse_mass_, contact_, evaluation_, u);
+  AccelerationStrips strips(hooks, a, inverse_mass_, contact_, evaluation_, u, v);
   model_->evaluateInStrips(u, v, stage_.positionAfter(t - time_), a, evaluation_, strips, kStripNodes);
   return evaluation_.viscous_power;
 }
 
-void Simulation::reapplyFriction() { contact_.reapplyFriction(u_, inverse_mass_, a_); }
+void Simulation::reapplyFriction() { contact_.reapplyFriction(u_, v_, inverse_mass_, a_); }
 
 Simulation::StepStart Simulation::stepStart() const {
   return {contact_.contactChanges(), quasiStatic(), stageTooFast(), evaluation_.shear_force, stage_.position()};
@@ -101,6 +101,7 @@ Simulation::StepStart Simulation::stepStart() const {
 void Simulation::advanceClock() {
   stage_.advance(dt_);
   time_ += dt_;
+  contact_.setTime(time_);
   ++steps_;
 }
 

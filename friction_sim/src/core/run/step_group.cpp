@@ -50,7 +50,7 @@ void Simulation::stepInGroup(double group_before) {
         }
         ForceEvaluation& evaluation = groupEvaluation(k);
         contact_.lendNormalStorage(evaluation.normal_force);
-        group.strips[k].emplace(group.passes, a_, inverse_mass_, contact_, evaluation, u_);
+        group.strips[k].emplace(group.passes, a_, inverse_mass_, contact_, evaluation, u_, v_);
         return StripEvaluation{u_, v_, stage_.positionAfter((time_ + dt_) - time_), a_, evaluation, *group.strips[k]};
       });
   // The steps' energy, in order, now that their sums are known; the clock stands at the last one's end.

@@ -27,7 +27,8 @@ const EnumTable<InterfaceLoading> kInterfaceLoadingNames{{InterfaceLoading::Stuc
                                                          {InterfaceLoading::Free, "free"}};
 const EnumTable<ChainDriving> kDrivingNames{{ChainDriving::Side, "side"}, {ChainDriving::Top, "top"}};
 const EnumTable<FrictionLawKind> kLawNames{{FrictionLawKind::AmontonsCoulomb, "amontons_coulomb"},
-                                           {FrictionLawKind::SlipWeakening, "slip_weakening"}};
+                                           {FrictionLawKind::SlipWeakening, "slip_weakening"},
+                                           {FrictionLawKind::RateState, "rate_state"}};
 const EnumTable<IntegratorKind> kSchemeNames{{IntegratorKind::VelocityVerlet, "velocity_verlet"},
                                              {IntegratorKind::RungeKutta4, "rk4"}};
 const EnumTable<StageMode> kStageModeNames{
@@ -96,6 +97,13 @@ void visitRig(Scene& s, Visitor& v) {
     v.field("static_coefficient", s.friction.static_coefficient);
     v.field("kinetic_coefficient", s.friction.kinetic_coefficient);
     v.field("weakening_length", s.friction.weakening_length);
+    v.field("reference_coefficient", s.friction.rate_state.reference_coefficient);
+    v.field("direct_effect", s.friction.rate_state.direct_effect);
+    v.field("ageing_effect", s.friction.rate_state.ageing_effect);
+    v.field("characteristic_slip", s.friction.rate_state.characteristic_slip);
+    v.field("reference_speed", s.friction.rate_state.reference_speed);
+    v.field("reference_age", s.friction.rate_state.reference_age);
+    v.field("initial_age", s.friction.rate_state.initial_age);
     v.field("interfacial_stiffness", s.friction.interfacial_stiffness);
   });
   v.section("load", [&] {

@@ -95,6 +95,24 @@ void checkChain(Checker& check, const Scene& s) {
   }
 }
 
+void checkRateState(Checker& check, const Scene& s) {
+  const RateStateSpec& r = s.friction.rate_state;
+  check.positive("friction.reference_coefficient", r.reference_coefficient);
+  check.nonNegative("friction.direct_effect", r.direct_effect);
+  check.nonNegative("friction.ageing_effect", r.ageing_effect);
+  check.positive("friction.characteristic_slip", r.characteristic_slip);
+  check.positive("friction.reference_speed", r.reference_speed);
+  check.positive("friction.reference_age", r.reference_age);
+  check.require(r.initial_age >= 0.0 && std::isfinite(r.initial_age), "friction.initial_age", r.initial_age,
+                "a finite age >= 0 s");
+  // Its sliding friction is solved with the closing half-kick's velocity (ContactInterface); Runge–Kutta's
+  // stages would evaluate it explicitly, unstable at any usable step.
+  if (s.integrator.scheme != IntegratorKind::VelocityVerlet) {
+    check.problems.push_back(
+        "integrator.scheme: rk4 is not allowed with friction.law rate_state; allowed: velocity_verlet");
+  }
+}
+
 void checkFriction(Checker& check, const Scene& s) {
   const double mu_s = s.friction.static_coefficient, mu_k = s.friction.kinetic_coefficient;
   check.nonNegative("friction.static_coefficient", mu_s);
@@ -106,6 +124,7 @@ void checkFriction(Checker& check, const Scene& s) {
   }
   check.nonNegative("friction.weakening_length", s.friction.weakening_length);
   check.nonNegative("friction.interfacial_stiffness", s.friction.interfacial_stiffness);
+  if (s.friction.law == FrictionLawKind::RateState) checkRateState(check, s);
 }
 
 void checkLoad(Checker& check, const Scene& s) {
@@ -185,7 +204,7 @@ void checkChainStatics(Checker& check, const Scene& s) {
   const Chain1D chain(s);
   // |F_X| stays below the interface's total static friction µ_s·F_Z, in either direction: the stage
   // program or the controller may drive the stage back. w_i is linear in F_X, so the ends suffice.
-  const double most_shear = s.friction.static_coefficient * s.load.normal_force;
+  const double most_shear = s.friction.initialStaticCoefficient() * s.load.normal_force;
   bool reported = false;
   for (double shear : {0.0, most_shear, -most_shear}) {
     const std::vector<double> w = chain.normalForces(shear);
@@ -207,7 +226,7 @@ void checkChainStatics(Checker& check, const Scene& s) {
     for (double f : shear_profile) held_by_pusher -= f;
     const std::vector<double> w = chain.normalForces(held_by_pusher);
     for (std::size_t i = 0; i < shear_profile.size(); ++i) {
-      const double threshold = s.friction.static_coefficient * std::max(w[i], 0.0);
+      const double threshold = s.friction.initialStaticCoefficient() * std::max(w[i], 0.0);
       if (std::abs(shear_profile[i]) <= threshold) continue;
       std::ostringstream allowed;
       allowed << "|f| <= mu_s * w_" << i << " = " << threshold << " N, the block's static threshold with the pusher "
