@@ -286,7 +286,9 @@ TEST(RateStateBlock, StaticFrictionAfterAHoldGrowsWithTheLogarithmOfItsLength) {
     EXPECT_NEAR(peak / law - 1.0, 0.0, 1e-3) << "hold " << hold << " s";
     log_holds.push_back(std::log(hold));
     peaks.push_back(peak);
-    if (hold == 100.0) EXPECT_LT(simulation.steps(), 200000) << "a 100 s hold must cost a few jumps";
+    if (hold == 100.0) {
+      EXPECT_LT(simulation.steps(), 200000) << "a 100 s hold must cost a few jumps";
+    }
   }
   // A hold of 100 s costs no more steps than one of 0.1 s (about 10⁵, the slides'): a few jumps.
   // Slope against ln t_h between 10 and 100 s: b·f0·t/(φ* + D/V + t) ≈ b·f0.
