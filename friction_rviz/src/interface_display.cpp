@@ -7,7 +7,9 @@
 #include <rviz/properties/float_property.h>
 #include <rviz/properties/int_property.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "frame_placement.h"
 #include "friction_rviz/color_map.h"
@@ -23,12 +25,15 @@ InterfaceDisplay::InterfaceDisplay() : history_(300) {
   field_ = new rviz::EnumProperty("Field", "slip velocity", "What the strip shows.", this, SLOT(markDirty()));
   field_->addOption("slip velocity", 0);
   field_->addOption("slip", 1);
+  field_->addOption("static friction", 2);
   height_ = new rviz::FloatProperty("Strip height", 0.06, "Height of the strip in the slider frame (m).", this,
                                     SLOT(markDirty()));
   offset_ =
       new rviz::FloatProperty("Strip base", 0.09, "z of the strip's bottom (newest) row (m).", this, SLOT(markDirty()));
   scale_ = new rviz::FloatProperty("Full scale", 0.0,
-                                   "Value drawn at full colour (m/s or m); 0 takes the largest in the strip.", this,
+                                   "Value drawn at full colour (m/s or m); 0 takes the largest in the strip. Static "
+                                   "friction spans the strip's own range.",
+                                   this,
                                    SLOT(markDirty()));
 }
 
@@ -58,7 +63,8 @@ void InterfaceDisplay::markDirty() { dirty_ = true; }
 
 void InterfaceDisplay::processMessage(const friction_msgs::InterfaceState::ConstPtr& msg) {
   if (!placeAtMessageFrame(*this, *context_, msg->header, *scene_node_)) return;
-  const auto& values = field_->getOptionInt() == 0 ? msg->slip_velocity : msg->slip;
+  const int field = field_->getOptionInt();
+  const auto& values = field == 0 ? msg->slip_velocity : field == 1 ? msg->slip : msg->static_coefficient;
   if (history_.add(msg->header.stamp.toSec(), msg->position, values, msg->state)) {
     setStatus(rviz::StatusProperty::Warn, "Time", "time jumped back: history cleared");
   }
@@ -71,18 +77,30 @@ void InterfaceDisplay::update(float, float) {
   redraw();
 }
 
+Range InterfaceDisplay::colourRange() const {
+  // Static friction differs from node to node by a few per cent around 0.3–0.6: black to yellow over the
+  // strip's own spread shows its pattern. The other fields run from zero.
+  const bool spread = field_->getOptionInt() == 2;
+  double low = spread ? std::numeric_limits<double>::infinity() : 0.0, high = scale_->getFloat();
+  if (spread || high <= 0.0) {
+    high = 0.0;
+    for (std::size_t r = 0; r < history_.size(); ++r) {
+      for (double value : history_.row(r)) {
+        high = std::max(high, std::abs(value));
+        low = std::min(low, std::abs(value));
+      }
+    }
+  }
+  if (!(high > low)) return {0.0, high > 0.0 ? high : 1.0};
+  return {low, high};
+}
+
 void InterfaceDisplay::redraw() {
   strip_->clear();
   const std::size_t rows = history_.size();
   const auto& x = history_.positions();
   if (rows < 1 || x.size() < 2) return;
-  double full = scale_->getFloat();
-  if (full <= 0.0) {
-    for (std::size_t r = 0; r < rows; ++r) {
-      for (double value : history_.row(r)) full = std::max(full, std::abs(value));
-    }
-  }
-  const Range range{0.0, full > 0.0 ? full : 1.0};
+  const Range range = colourRange();
   const float height = height_->getFloat(), base = offset_->getFloat();
   const float row_height = height / static_cast<float>(rows_->getInt());
   const double half = 0.5 * (x[1] - x[0]);
@@ -95,7 +113,7 @@ void InterfaceDisplay::redraw() {
     const float z0 = row_z(r), z1 = z0 + row_height;
     for (std::size_t i = 0; i < row.size() && i < x.size(); ++i) {
       // Black at rest, through red to yellow at full scale: the camera's |dA/dt| picture.
-      const double s = std::min(std::abs(row[i]) / range.max, 1.0);
+      const double s = std::clamp((std::abs(row[i]) - range.min) / (range.max - range.min), 0.0, 1.0);
       const Ogre::ColourValue c(static_cast<float>(std::min(1.0, 2.0 * s)),
                                 static_cast<float>(std::max(0.0, 2.0 * s - 1.0)), 0.05f);
       const float xa = static_cast<float>(x[i] - half), xb = static_cast<float>(x[i] + half);

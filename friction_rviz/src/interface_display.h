@@ -7,6 +7,7 @@
 #include <friction_msgs/InterfaceState.h>
 #include <rviz/message_filter_display.h>
 
+#include "friction_rviz/color_map.h"
 #include "friction_rviz/history.h"
 #endif
 
@@ -40,6 +41,8 @@ class InterfaceDisplay : public rviz::MessageFilterDisplay<friction_msgs::Interf
  private:
   void processMessage(const friction_msgs::InterfaceState::ConstPtr& msg) override;
   void redraw();
+  /// The values drawn black and full yellow: from zero, or over the strip's own spread (static friction).
+  Range colourRange() const;
 
   rviz::IntProperty* rows_;
   rviz::EnumProperty* field_;

@@ -46,6 +46,7 @@ TEST(Conversions, InterfaceFrameRoundTrips) {
   frame.friction_force = {-3.0, -5.27, 0.0};
   frame.normal_stress = {2e6, 2.1e6, 0.0};
   frame.shear_stress = {2e5, 3.5e5, 0.0};
+  frame.static_coefficient = {0.55, 0.43, 0.56};
   const auto msg = toMsg(frame, 42, "slider");
   EXPECT_EQ(msg.frame_index, 42u);
   EXPECT_EQ(msg.state[1], friction_msgs::InterfaceState::SLIDING);
@@ -56,6 +57,7 @@ TEST(Conversions, InterfaceFrameRoundTrips) {
   EXPECT_EQ(back.slip, frame.slip);
   EXPECT_EQ(back.friction_force, frame.friction_force);
   EXPECT_EQ(back.shear_stress, frame.shear_stress);
+  EXPECT_EQ(back.static_coefficient, frame.static_coefficient);
 }
 
 TEST(Conversions, SlipEventCarriesEveryQuantity) {

@@ -332,6 +332,14 @@ TEST(RateStateBlock, EnergyBudgetClosesThroughStickSlip) {
   EXPECT_LT(std::abs(simulation.energy().relativeResidual()), 1e-5);
 }
 
+TEST(RateStateBlock, TheCameraShowsTheStaticFrictionOfTheContactsAge) {
+  Simulation simulation(loadScene(testing::scenePath("rate_state")));
+  runTo(simulation, 0.3);  // stuck: the first event comes at 0.67 s
+  const InterfaceFrame frame = simulation.interfaceFrame();
+  ASSERT_EQ(frame.static_coefficient.size(), 1u);
+  EXPECT_DOUBLE_EQ(frame.static_coefficient[0], kPmma.staticCoefficient(100.0 + simulation.time()));
+}
+
 // ---- Hard cases: each stable, with the number it must give ---------------------------------------------
 
 TEST(RateStateHardCases, VelocityJumpOfSixDecadesSettlesOnTheSteadyStateOfTheNewSpeed) {

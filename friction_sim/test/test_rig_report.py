@@ -34,12 +34,13 @@ def event(index, onset, shear_ratio, rupture_length, slider_length=0.14):
 
 
 def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None, normal_load_rise=0.0,
-              commands=True, scene_again=None, resets=0, first_resets=0):
+              commands=True, scene_again=None, resets=0, first_resets=0, ageing=False):
     """Load cells and frames for 0.1 s (F_Z rising by `normal_load_rise` N per ms), two events from the
     simulator and, unless not `detector`, the same two, with the detector's slightly later reading of F_X,
     from the detector; `also` another rig's namespace with the same; unless not `commands`, a drive and a
     normal-load command as applied; `scene_again` a second scene message (the rig's with its run end);
-    stage states counting `resets` during the recording, from `first_resets` before it."""
+    stage states counting `resets` during the recording, from `first_resets` before it; with `ageing`,
+    frames whose static coefficients rise with time."""
     if also:
         write_bag(path + ".also", also, detector, slider_length)
     with rosbag.Bag(path, "w") as bag:
@@ -71,6 +72,7 @@ def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=No
             frame.position = [0.0, 0.07, 0.14]
             frame.slip_velocity = [0.0, 0.0, 0.0]
             frame.state = [0, 0, 0]
+            frame.static_coefficient = [0.5 + 1e-4 * step] * 3 if ageing else [0.4] * 3
             bag.write(namespace + "/interface", frame, stamp)
         sources = [("/slip_events", 0.0)] + ([("/precursor_detector/slip_events", 1e-4)] if detector else [])
         for source, later in sources:
@@ -116,6 +118,15 @@ class RigReportTest(unittest.TestCase):
         # And the command that reruns the run from the two.
         self.assertIn("friction_run {0}/scene.yaml --commands {0}/stage_commands.csv --out {0}/rerun".format(self.work),
                       done.stdout)
+
+    def test_static_friction_is_mapped_only_where_it_changes(self):
+        self.assertEqual(self.report().returncode, 0)
+        self.assertFalse(os.path.exists(os.path.join(self.work, "static_friction.png")))  # µ_s = 0.4 throughout
+        write_bag(self.bag, ageing=True)
+        done = self.report()
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertTrue(os.path.exists(os.path.join(self.work, "static_friction.png")))
+        self.assertIn("static_friction.png", done.stdout)
 
     def test_the_scene_is_the_last_recorded_and_a_bag_without_commands_says_so(self):
         # The rig records its scene again with the run's end when a controller sets it.

@@ -45,6 +45,7 @@ friction_msgs::InterfaceState toMsg(const InterfaceFrame& frame, std::uint32_t f
   msg.friction_force = frame.friction_force;
   msg.normal_stress = frame.normal_stress;
   msg.shear_stress = frame.shear_stress;
+  msg.static_coefficient = frame.static_coefficient;
   return msg;
 }
 
@@ -59,6 +60,7 @@ InterfaceFrame fromMsg(const friction_msgs::InterfaceState& msg) {
   frame.friction_force = msg.friction_force;
   frame.normal_stress = msg.normal_stress;
   frame.shear_stress = msg.shear_stress;
+  frame.static_coefficient = msg.static_coefficient;
   return frame;
 }
 

@@ -55,6 +55,8 @@ struct InterfaceFrame {
   std::vector<double> friction_force;  ///< N, f_i, x force of the track on the slider
   std::vector<double> normal_stress;   ///< Pa, σ_i = N_i/(l·B), positive in compression
   std::vector<double> shear_stress;    ///< Pa, τ_i = −f_i/(l·B), positive when resisting a push in +x
+  /// µ_s each node holds up to now, dimensionless: the law's (rate_state: µ(0, φ), rising with the age φ)
+  std::vector<double> static_coefficient;
 };
 
 /// Strain gauges at height z_g: stress tensor components (tension positive).

@@ -69,7 +69,8 @@ InterfaceFrame interpolate(const InterfaceFrame& a, const InterfaceFrame& b, dou
   auto [out, w] = startAt(a, b, t);
   if (t < b.time) out.state = a.state;
   for (auto field : {&InterfaceFrame::slip_velocity, &InterfaceFrame::slip, &InterfaceFrame::normal_force,
-                     &InterfaceFrame::friction_force, &InterfaceFrame::normal_stress, &InterfaceFrame::shear_stress}) {
+                     &InterfaceFrame::friction_force, &InterfaceFrame::normal_stress, &InterfaceFrame::shear_stress,
+                     &InterfaceFrame::static_coefficient}) {
     blend(a.*field, out.*field, w);
   }
   return out;

@@ -30,6 +30,7 @@ InterfaceFrame Simulation::interfaceFrame() const {
     frame.friction_force.push_back(contact_.frictionForce(node));
     frame.normal_stress.push_back(contact_.normalForce(node) / area);
     frame.shear_stress.push_back(-contact_.frictionForce(node) / area);
+    frame.static_coefficient.push_back(contact_.law().staticCoefficient(node));
   }
   return frame;
 }
