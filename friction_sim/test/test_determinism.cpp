@@ -25,6 +25,7 @@ constexpr Pin kPins[] = {
     {"pmma_1d_side", 0x1134ed5206e1b6ccULL},
     {"pmma_1d_top", 0x556f54bc1cb604d3ULL},
     {"pmma_2d", 0xe8c93851ef6a52e9ULL},
+    {"rate_state", 0xff1a9852884f553eULL},
 };
 
 void PrintTo(const Pin& pin, std::ostream* out) { *out << pin.scene; }

@@ -151,13 +151,14 @@ TEST(RateStateSpec, SteadyStateWeakensThenStrengthensWithItsMinimumWhereTheSlope
 // ---- One block on a spring --------------------------------------------------------------------------
 
 /// The whole slider as one rate-and-state block driven through a spring of `stiffness` (N/m) at `speed`
-/// (m/s), with steps of `time_step` (s) and contacts `initial_age` (s) old.
+/// (m/s), with steps of `time_step` (s) and contacts `initial_age` (s) old, without fast-forward.
 Scene rateStateBlock(double stiffness, double speed, double time_step, double initial_age) {
   Scene scene = loadScene(testing::scenePath("rate_state"));
   scene.pusher.stiffness = stiffness;
   scene.stage.max_speed = 10.0;
   scene.stage.program = {StageSegment{StageMode::Velocity, speed}};
   scene.integrator.time_step = time_step;
+  scene.integrator.fast_forward = false;  // full dynamics: a test that jumps says so
   scene.friction.rate_state.initial_age = initial_age;
   scene.stop = StopSpec{0, 1e6, std::numeric_limits<double>::infinity()};
   return scene;
