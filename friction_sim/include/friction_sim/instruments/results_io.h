@@ -56,7 +56,7 @@ void writeStressRows(std::ostream& out, int event, const char* phase, const Inte
                      const GaugeProfile& gauges);
 /// A stream that writes stresses.csv as the run goes, its header first: at each event's onset the loaded
 /// state that gave way, at its end the state then; `ended`, if given, is called after the end's rows.
-std::unique_ptr<EventStream> stressesStream(std::ostream& out, EventStream::Ended ended = nullptr);
+std::unique_ptr<EventStream> stressesStream(std::ostream& out, const EventStream::Ended& ended = nullptr);
 
 /// The result folder's files written at a run's end, in `out_dir`: events.csv, event_nodes.csv,
 /// loading.csv, scene.yaml (the scene as run) and summary.txt, the summary also printed to `console`.

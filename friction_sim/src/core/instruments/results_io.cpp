@@ -125,7 +125,7 @@ void writeStressRows(std::ostream& out, int event, const char* phase, const Inte
   }
 }
 
-std::unique_ptr<EventStream> stressesStream(std::ostream& out, EventStream::Ended ended) {
+std::unique_ptr<EventStream> stressesStream(std::ostream& out, const EventStream::Ended& ended) {
   writeStressesHeader(out);
   return std::make_unique<EventStream>(
       [&out](const Simulation& s) {
