@@ -33,8 +33,7 @@ InterfaceDisplay::InterfaceDisplay() : history_(300) {
   scale_ = new rviz::FloatProperty("Full scale", 0.0,
                                    "Value drawn at full colour (m/s or m); 0 takes the largest in the strip. Static "
                                    "friction spans the strip's own range.",
-                                   this,
-                                   SLOT(markDirty()));
+                                   this, SLOT(markDirty()));
 }
 
 InterfaceDisplay::~InterfaceDisplay() {

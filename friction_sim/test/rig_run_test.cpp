@@ -105,6 +105,12 @@ ros::Subscriber listen(ros::NodeHandle& nh, const std::string& topic, Callback c
   return nh.subscribe<Message>(topic, 10000, boost::function<void(const typename Message::ConstPtr&)>(callback));
 }
 
+/// Subscribes to `topic`, keeping every message in `kept`.
+template <class Message>
+ros::Subscriber keep(ros::NodeHandle& nh, const std::string& topic, std::vector<Message>& kept) {
+  return listen<Message>(nh, topic, [&kept](const typename Message::ConstPtr& m) { kept.push_back(*m); });
+}
+
 /// A stand-in for the simulator, in a namespace of its own, for a controller run against it: its
 /// services and its stage_state answer on a queue of their own while the controller runs.
 class StandInSimulator {
@@ -572,20 +578,11 @@ TEST(KillRun, BagIsReadableAndHoldsEverythingUpToTheKill) {
 void watchFullRun(ros::NodeHandle& nh) {
   auto rig = std::make_shared<ros::NodeHandle>("/rig");
   std::vector<ros::Subscriber> subs;
-  subs.push_back(listen<friction_msgs::SlipEvent>(
-      nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); }));
-  subs.push_back(listen<friction_msgs::PrecursorPoint>(
-      nh, "/rig/precursor_detector/precursor_points",
-      [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.live_points.push_back(*m); }));
-  subs.push_back(listen<friction_msgs::PrecursorPoint>(
-      nh, "/replay/precursor_detector/precursor_points",
-      [](const friction_msgs::PrecursorPoint::ConstPtr& m) { g_seen.replay_points.push_back(*m); }));
-  subs.push_back(listen<friction_msgs::SlipEvent>(
-      nh, "/rig/precursor_detector/slip_events",
-      [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.live_detector_events.push_back(*m); }));
-  subs.push_back(listen<friction_msgs::SlipEvent>(
-      nh, "/replay/precursor_detector/slip_events",
-      [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.replay_detector_events.push_back(*m); }));
+  subs.push_back(keep(nh, "/rig/slip_events", g_seen.events));
+  subs.push_back(keep(nh, "/rig/precursor_detector/precursor_points", g_seen.live_points));
+  subs.push_back(keep(nh, "/replay/precursor_detector/precursor_points", g_seen.replay_points));
+  subs.push_back(keep(nh, "/rig/precursor_detector/slip_events", g_seen.live_detector_events));
+  subs.push_back(keep(nh, "/replay/precursor_detector/slip_events", g_seen.replay_detector_events));
   subs.push_back(listen<rosgraph_msgs::Clock>(
       nh, "/clock", [](const rosgraph_msgs::Clock::ConstPtr& m) { g_seen.clock.push_back(m->clock.toSec()); }));
   subs.push_back(listen<friction_msgs::StrainGaugeProfile>(
@@ -656,8 +653,7 @@ void watchFullRun(ros::NodeHandle& nh) {
 }
 
 void watchKilledRun(ros::NodeHandle& nh) {
-  ros::Subscriber events = listen<friction_msgs::SlipEvent>(
-      nh, "/rig/slip_events", [](const friction_msgs::SlipEvent::ConstPtr& m) { g_seen.events.push_back(*m); });
+  ros::Subscriber events = keep(nh, "/rig/slip_events", g_seen.events);
   waitFor([] { return g_seen.events.size() >= 3; }, 240.0);
   std::string output;
   runCommand("rosnode kill /rig/simulator", output);

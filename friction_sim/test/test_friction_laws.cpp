@@ -4,42 +4,18 @@
 
 #include "friction_sim/contact/contact_interface.h"
 #include "friction_sim/model/chain_1d.h"
+#include "one_node.h"
 
 namespace friction {
 namespace {
 
 constexpr double kMuS = 0.4, kMuK = 0.17;
 
-/// One interface node (a single block) whose forces the test sets by hand.
-class OneNode : public ::testing::Test {
+/// One Amontons–Coulomb node, unless a test gives another law.
+class OneNode : public testing::OneInterfaceNode {
  protected:
   OneNode() : OneNode(std::make_unique<AmontonsCoulomb>(kMuS, kMuK)) {}
-  explicit OneNode(std::unique_ptr<FrictionLaw> law) : block_(blockScene()), contact_(std::move(law), block_, 0.0) {
-    u_ = Vector::Zero(1);
-    v_ = Vector::Zero(1);
-    contact_.reset(u_);
-  }
-  static Scene blockScene() {
-    Scene scene;
-    scene.model = ModelKind::Chain1D;
-    scene.chain.blocks = 1;
-    return scene;
-  }
-  /// Friction for a tangential force `other` (N) and normal force `normal` (N); returns the net force
-  /// (the acceleration of a 1 kg block).
-  double net(double other, double normal) {
-    raw_.force = Vector::Constant(1, other);
-    contact_.lendNormalStorage(raw_.normal_force);
-    raw_.normal_force = Vector::Constant(1, normal);
-    Vector force = raw_.force;
-    contact_.applyFriction(raw_, u_, v_, 1.0, force);
-    return force[0];
-  }
-  /// The state update after a force evaluation giving `other` and `normal` (N).
-  bool update(double other, double normal) {
-    net(other, normal);
-    return contact_.updateStates(u_, v_, 0.0, 1.0);
-  }
+  explicit OneNode(std::unique_ptr<FrictionLaw> law) : OneInterfaceNode(std::move(law)) {}
   /// Unsticks the node forwards and ends one step of length `dt` with it sliding, so that it is no longer
   /// "just unstuck" and may re-stick in the next step.
   void slideThroughOneStep(double dt) {
@@ -48,11 +24,6 @@ class OneNode : public ::testing::Test {
     contact_.beginStep(u_, v_);
     contact_.finishStep(u_, v_, dt);
   }
-
-  Chain1D block_;
-  ContactInterface contact_;
-  ForceEvaluation raw_;
-  Vector u_, v_;
 };
 
 TEST_F(OneNode, StuckNodeCarriesWhateverHoldsItUpToStaticFriction) {

@@ -10,6 +10,7 @@
 #include "friction_sim/contact/contact_interface.h"
 #include "friction_sim/model/chain_1d.h"
 #include "friction_sim/run/simulation.h"
+#include "one_node.h"
 #include "test_helpers.h"
 
 namespace friction {
@@ -17,44 +18,16 @@ namespace {
 
 const RateStateSpec kPmma;  // the PMMA defaults
 
-/// One interface node with a rate-and-state law, its forces set by hand (1 kg, unless a test says).
-class OneAgeingNode : public ::testing::Test {
+/// One interface node with a rate-and-state law, its forces set by hand (1 kg).
+class OneAgeingNode : public testing::OneInterfaceNode {
  protected:
-  OneAgeingNode() : block_(blockScene()), contact_(std::make_unique<RateAndState>(spec()), block_, 0.0) {
-    u_ = Vector::Zero(1);
-    v_ = Vector::Zero(1);
-    contact_.reset(u_);
-  }
+  OneAgeingNode() : OneInterfaceNode(std::make_unique<RateAndState>(spec())) {}
   static RateStateSpec spec() {
     RateStateSpec spec;
     spec.initial_age = 10.0;
     return spec;
   }
-  static Scene blockScene() {
-    Scene scene;
-    scene.model = ModelKind::Chain1D;
-    scene.chain.blocks = 1;
-    return scene;
-  }
   const RateAndState& law() const { return static_cast<const RateAndState&>(contact_.law()); }
-  /// Friction for `other` (N) and `normal` (N) with a closing kick of `kick` (s); returns the acceleration.
-  double net(double other, double normal, double kick = 0.0) {
-    raw_.force = Vector::Constant(1, other);
-    contact_.lendNormalStorage(raw_.normal_force);
-    raw_.normal_force = Vector::Constant(1, normal);
-    Vector force = raw_.force;
-    contact_.applyFriction(raw_, u_, v_, 1.0, force, 0, 1, kick);
-    return force[0];
-  }
-  bool update(double other, double normal) {
-    net(other, normal);
-    return contact_.updateStates(u_, v_, 0.0, 1.0);
-  }
-
-  Chain1D block_;
-  ContactInterface contact_;
-  ForceEvaluation raw_;
-  Vector u_, v_;
 };
 
 TEST_F(OneAgeingNode, StuckNodeAgesWithTimeAndHoldsUpToItsStaticFriction) {
@@ -266,18 +239,23 @@ TEST(RateStateBlock, VelocityStepJumpsByTheDirectEffectThenEvolvesOverTheCharact
   EXPECT_NEAR(frictionRatio(simulation) / kPmma.steadyStateCoefficient(v2) - 1.0, 0.0, 1e-4);
 }
 
+/// The block (K = 1 GN/m, 2 µs steps, fast-forward) sliding at `speed` (m/s) for 0.1 s from steady state,
+/// held `hold` s, sliding 0.1 s again and held: the slip after the hold ends as the second event.
+Scene slideHoldSlide(double speed, double hold) {
+  Scene scene = rateStateBlock(1e9, speed, 2e-6, kPmma.characteristic_slip / speed);
+  scene.integrator.fast_forward = true;
+  scene.stage.program = {StageSegment{StageMode::Velocity, speed, 0.0, 0.1},
+                         StageSegment{StageMode::Hold, 0.0, 0.0, hold},
+                         StageSegment{StageMode::Velocity, speed, 0.0, 0.1}, StageSegment{StageMode::Hold}};
+  scene.stop.global_events = 2;
+  return scene;
+}
+
 TEST(RateStateBlock, StaticFrictionAfterAHoldGrowsWithTheLogarithmOfItsLength) {
-  const double speed = 1e-4, slide = 0.1;
+  const double speed = 1e-4;
   std::vector<double> log_holds, peaks;
   for (double hold : {0.1, 1.0, 10.0, 100.0}) {
-    Scene scene = rateStateBlock(1e9, speed, 2e-6, kPmma.characteristic_slip / speed);
-    scene.integrator.fast_forward = true;
-    // Slide, hold, slide, and hold again: the slip after the hold ends as an event.
-    scene.stage.program = {StageSegment{StageMode::Velocity, speed, 0.0, slide},
-                           StageSegment{StageMode::Hold, 0.0, 0.0, hold},
-                           StageSegment{StageMode::Velocity, speed, 0.0, slide}, StageSegment{StageMode::Hold}};
-    scene.stop.global_events = 2;
-    Simulation simulation(scene);
+    Simulation simulation(slideHoldSlide(speed, hold));
     runTo(simulation, hold + 10.0);
     ASSERT_EQ(simulation.events().size(), 2u) << "hold " << hold << " s";
     const SlipEvent& after_hold = simulation.events()[1];
@@ -355,12 +333,7 @@ TEST(RateStateHardCases, VelocityJumpOfSixDecadesSettlesOnTheSteadyStateOfTheNew
 
 TEST(RateStateHardCases, HoldOfTenThousandSecondsAgesExactlyInAFewJumps) {
   const double speed = 1e-4, hold = 1e4;
-  Scene scene = rateStateBlock(1e9, speed, 2e-6, kPmma.characteristic_slip / speed);
-  scene.integrator.fast_forward = true;
-  scene.stage.program = {StageSegment{StageMode::Velocity, speed, 0.0, 0.1}, StageSegment{StageMode::Hold, 0.0, 0.0, hold},
-                         StageSegment{StageMode::Velocity, speed, 0.0, 0.1}, StageSegment{StageMode::Hold}};
-  scene.stop.global_events = 2;
-  Simulation simulation(scene);
+  Simulation simulation(slideHoldSlide(speed, hold));
   runTo(simulation, hold + 10.0);
   ASSERT_EQ(simulation.events().size(), 2u);
   const SlipEvent& after_hold = simulation.events()[1];

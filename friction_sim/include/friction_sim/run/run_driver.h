@@ -210,6 +210,10 @@ class RunDriver {
  private:
   /// s, where the next advance must end at the latest.
   double jumpEnd() const;
+  /// Schedules `commands`; returns how many.
+  std::size_t scheduleAll(const std::vector<TimedCommand>& commands);
+  /// The simulation's refusal of a command, for the loaders' checks.
+  CommandCheck commandCheck() const;
 
   Simulation simulation_;
   RunOptions options_;

@@ -158,6 +158,7 @@ void FastForward::findFirstCrossing(Path& path, const ForceEvaluation& here, con
     lift = s.model_->signedNormalForces(s.u_, here);
     lift_moved = s.model_->signedNormalForces(probed, moved);
   }
+  const bool ageing = contact.law().ages();
   for (int node = 0; node < contact.size(); ++node) {
     if (contact.state(node) == ContactState::Detached) {
       const double lift_rate = (lift_moved[node] - lift[node]) / probe * speed;
@@ -174,9 +175,8 @@ void FastForward::findFirstCrossing(Path& path, const ForceEvaluation& here, con
       const double slope = sign * force_rate - mu * normal_rate;
       if (!(slope > 0.0)) continue;
       const double crossing = (mu * normal - sign * force) / slope;
-      stop_at(contact.law().ages()
-                  ? agedCrossing(node, sign, force, force_rate, normal, normal_rate, crossing, path.length)
-                  : crossing);
+      stop_at(ageing ? agedCrossing(node, sign, force, force_rate, normal, normal_rate, crossing, path.length)
+                     : crossing);
     }
     if (normal_rate < 0.0) stop_at(-normal / normal_rate);
   }

@@ -37,18 +37,22 @@ std::string RunDriver::setRunEnd(const StopSpec& stop) {
   return refusal;
 }
 
-std::size_t RunDriver::scheduleCommandTable(const std::string& path) {
-  const auto commands =
-      loadCommandTable(path, [this](const TimedCommand& command) { return simulation_.checkCommand(command); });
+std::size_t RunDriver::scheduleAll(const std::vector<TimedCommand>& commands) {
   for (const TimedCommand& command : commands) schedule(command);
   return commands.size();
 }
 
+CommandCheck RunDriver::commandCheck() const {
+  return [this](const TimedCommand& command) { return simulation_.checkCommand(command); };
+}
+
+std::size_t RunDriver::scheduleCommandTable(const std::string& path) {
+  return scheduleAll(loadCommandTable(path, commandCheck()));
+}
+
 std::size_t RunDriver::scheduleProtocol(const LoadingProtocol& protocol, const std::string& path) {
-  checkProtocolSteps(protocol, path, [this](const TimedCommand& command) { return simulation_.checkCommand(command); });
-  const auto commands = protocolCommands(protocol, simulation_.scene().load.normal_force);
-  for (const TimedCommand& command : commands) schedule(command);
-  return commands.size();
+  checkProtocolSteps(protocol, path, commandCheck());
+  return scheduleAll(protocolCommands(protocol, simulation_.scene().load.normal_force));
 }
 
 double RunDriver::jumpEnd() const {
