@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 #include "friction_sim/instruments/frame_event_detector.h"
@@ -339,13 +340,17 @@ TEST(FrontSpeeds, AFrontAt600MetresPerSecondLeavingANucleationPatch) {
 }
 
 /// Runs `simulation` to its end and feeds `detector` as the simulator node publishes: frames every
-/// 50 steps during events, every 0.01 s while stuck, and at every step where a node unsticks or an
-/// event starts or ends; load cells every 1e-4 s and at the event boundaries. Returns what it found.
-std::vector<SlipEvent> eventsSeenByTheInstruments(Simulation& simulation, FrameEventDetector& detector) {
+/// 1e-5 s during events, every 0.01 s between them, and at every step where the interface changed
+/// (Simulation::interfaceChangedLastStep); load cells every 1e-4 s and at the event boundaries. Returns
+/// what it found. `after_step` sees the simulation after each step.
+constexpr double kFrameIntervalBetweenEvents = 1e-2;  // s
+std::vector<SlipEvent> eventsSeenByTheInstruments(Simulation& simulation, FrameEventDetector& detector,
+                                                  const std::function<void()>& after_step = {}) {
   std::vector<SlipEvent> found;
   double next_frame = 0.0, next_cells = 0.0;
   while (!simulation.finished()) {
     simulation.step();
+    if (after_step) after_step();
     const double t = simulation.time();
     const bool boundary = simulation.eventStartedLastStep() || simulation.eventEndedLastStep();
     if (boundary || t >= next_cells) {
@@ -354,7 +359,7 @@ std::vector<SlipEvent> eventsSeenByTheInstruments(Simulation& simulation, FrameE
     }
     if (simulation.interfaceChangedLastStep() || t >= next_frame) {
       detector.addFrame(simulation.interfaceFrame());
-      next_frame = t + (simulation.inEvent() ? 1e-5 : 1e-2);
+      next_frame = t + (simulation.inEvent() ? 1e-5 : kFrameIntervalBetweenEvents);
     }
     for (SlipEvent& event : detector.takeCompletedEvents()) found.push_back(std::move(event));
   }
@@ -398,6 +403,47 @@ TEST(FrameEventDetector, FindsTheSimulatorsEventsFromTheInstrumentsAlone) {
     EXPECT_NEAR(found[e].mean_normal_force, truth[e].mean_normal_force, 1e-9 * truth[e].mean_normal_force);
     for (std::size_t node = 0; node < truth[e].node_slip.size(); ++node) {
       EXPECT_NEAR(found[e].node_slip[node], truth[e].node_slip[node], 1e-12);
+    }
+  }
+}
+
+TEST(FrameEventDetector, RateStateEventsEndOnTheirSlipSpeedWhileTheInterfaceCreeps) {
+  // The rate-and-state slider on a coarse lattice (5 mm spacing), to its first global event. Its
+  // trailing edge creeps from F_X/F_Z ≈ 0.1 on (nodes sliding at 1e-5 to 1e-4 m/s, under the 1e-3 m/s
+  // of instruments.event_slip_speed): the events end while nodes still slide.
+  Scene scene = loadScene(testing::scenePath("pmma_2d_rate_state"));
+  scene.lattice.nodes_x = 29;
+  scene.lattice.nodes_z = 16;
+  scene.integrator.time_step = 4e-7;
+  Simulation simulation(scene);
+  const SlipCriterion criterion = slipCriterion(scene);
+  ASSERT_GT(criterion.speed, 0.0);
+  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal,
+                              scene.geometry.length, criterion);
+  int most_sliding_at_an_end = 0;
+  const std::vector<SlipEvent> found = eventsSeenByTheInstruments(simulation, detector, [&] {
+    if (simulation.eventEndedLastStep()) {
+      most_sliding_at_an_end = std::max(most_sliding_at_an_end, simulation.loadCells().sliding_nodes);
+    }
+  });
+  const auto& truth = simulation.events();
+  ASSERT_EQ(simulation.globalEventCount(), 1);
+  EXPECT_GT(most_sliding_at_an_end, 0);
+  EXPECT_GE(truth.size(), 2u);
+  expectTheSameEventsAndExtents(found, truth);
+  for (std::size_t e = 0; e < std::min(found.size(), truth.size()); ++e) {
+    SCOPED_TRACE("event " + std::to_string(e));
+    // An event ends at the first moment of a quiet time with no node slipping, so the next starts after it.
+    if (e > 0) {
+      EXPECT_GE(truth[e].onset_time - truth[e - 1].end_time, criterion.quiet_time);
+    }
+    // The camera sees a crossing of the slip speed at the end of its step; the simulator interpolates.
+    EXPECT_NEAR(found[e].onset_time, truth[e].onset_time, simulation.timeStep());
+    EXPECT_NEAR(found[e].end_time, truth[e].end_time, simulation.timeStep());
+    // The camera's slip counts from its last frame with no node slipping, up to one frame interval
+    // before the onset: creep since then, slower than the slip speed, adds to it.
+    for (std::size_t node = 0; node < truth[e].node_slip.size(); ++node) {
+      EXPECT_NEAR(found[e].node_slip[node], truth[e].node_slip[node], criterion.speed * kFrameIntervalBetweenEvents);
     }
   }
 }

@@ -33,6 +33,7 @@ DetectorSettings detectorSettings(const Scene* scene, int front_fit_nodes) {
     settings.wave_speeds = waveSpeeds(*scene);
     settings.front_fit_nodes = scene->instruments.front_fit_nodes;
     settings.slider_length = scene->geometry.length;
+    settings.slip = slipCriterion(*scene);
   }
   if (front_fit_nodes != 0) settings.front_fit_nodes = front_fit_nodes;
   return settings;
@@ -61,7 +62,7 @@ PrecursorDetector::PrecursorDetector(ros::NodeHandle nh, ros::NodeHandle private
 void PrecursorDetector::use(const DetectorSettings& settings) {
   settings_ = settings;
   detector_ = std::make_unique<FrameEventDetector>(settings.front_fit_nodes, settings.wave_speeds.longitudinal,
-                                                   settings.slider_length);
+                                                   settings.slider_length, settings.slip);
 }
 
 void PrecursorDetector::onScene(const std_msgs::String::ConstPtr& msg) {

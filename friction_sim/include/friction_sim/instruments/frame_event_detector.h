@@ -1,8 +1,9 @@
 // Slip events seen from the instruments alone (ROS-free core of the precursor detector node): the
 // interface camera's frames and the load cells, as an experimentalist has them. An event starts at a
-// frame with a sliding node after an all-stuck frame and ends at the next all-stuck frame; the slipped
-// nodes are those seen sliding in between. The simulator publishes a frame at every step where a node
-// unsticks and where an event ends, so the camera misses no node's slip and no event, provided that
+// frame with a slipping node (SlipCriterion) after a frame with none and ends at the next frame with
+// none, once the frames show none for the criterion's quiet time; the slipped nodes are those seen
+// slipping in between. The simulator publishes a frame at every
+// step where a node begins slipping and where an event ends, so the camera misses no node's slip and no event, provided that
 // every frame arrives (a frame lost, or a bag recorded before that rule, can hide a short slip).
 #pragma once
 
@@ -19,8 +20,10 @@ namespace friction {
 class FrameEventDetector {
  public:
   /// `front_fit_nodes` as in the scene; `longitudinal_speed` (m/s, c_L; ≤ 0 unknown) for the events'
-  /// median front speed (summarizeFrontSpeeds); `slider_length` (m, L; 0 unknown: the frames' span).
-  FrameEventDetector(int front_fit_nodes, double longitudinal_speed, double slider_length = 0.0);
+  /// median front speed (summarizeFrontSpeeds); `slider_length` (m, L; 0 unknown: the frames' span);
+  /// `criterion` the scene's (instruments.event_slip_speed).
+  FrameEventDetector(int front_fit_nodes, double longitudinal_speed, double slider_length = 0.0,
+                     SlipCriterion criterion = {});
 
   /// Load-cell samples, in time order.
   void addLoadCells(const LoadCellReading& reading);
@@ -43,11 +46,13 @@ class FrameEventDetector {
   int front_fit_nodes_;
   double longitudinal_speed_;
   double given_length_;         ///< m, L from the run's scene; 0 unknown
+  SlipCriterion criterion_;
   double frames_length_ = 0.0;  ///< m, the last interface node's x in the frames
   double last_frame_time_ = -std::numeric_limits<double>::infinity();
   int next_index_ = 0;
   std::deque<LoadCellReading> load_cells_;
   std::optional<InterfaceFrame> last_stuck_frame_;
+  std::optional<InterfaceFrame> quiet_frame_;  ///< the first of the current event's frames with no node slipping
   bool in_event_ = false;
   SlipEvent current_;
   ContactDuringEvent in_contact_;  ///< of the current event

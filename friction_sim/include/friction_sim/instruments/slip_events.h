@@ -1,7 +1,8 @@
-// Slip events (MODEL.md §6): an event starts when some interface node unsticks while all were stuck
-// and ends when all are stuck again. Detected from the contact interface after every step.
+// Slip events (MODEL.md §6): an event starts when some interface node starts slipping while none did
+// and ends when none does again. Detected from the contact interface after every step.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <limits>
 #include <vector>
@@ -81,11 +82,25 @@ class ContactDuringEvent {
   std::size_t count_ = 0;
 };
 
+/// When a node counts as slipping in an event, and when an event is over. Speed 0 counts every sliding
+/// node, and an event ends when none slides: for laws whose nodes stick between events. Rate-and-state
+/// nodes creep between events, slowly and under the load, so their events need a speed above that creep;
+/// a node near that speed, and a lattice ringing, cross it back and forth within one rupture, so such an
+/// event ends only once no node has slipped for a quiet time (slipCriterion).
+struct SlipCriterion {
+  double speed = 0.0;       ///< m/s, the least slip speed of a slipping node
+  double quiet_time = 0.0;  ///< s, no node slipping for this long ends an event (at the first moment of it)
+  bool slipping(ContactState state, double slip_velocity) const {
+    return state == ContactState::Sliding && std::abs(slip_velocity) >= speed;
+  }
+};
+
 class SlipEventDetector {
  public:
   /// `longitudinal_speed` (m/s, c_L) for the events' median front speed (summarizeFrontSpeeds).
   /// `slider_length` (m): L, the single block's L_p when it slips (measureExtent).
-  SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed, double slider_length);
+  SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed, double slider_length,
+                    SlipCriterion criterion = {});
 
   /// The load cells over the step just taken: F_X at its start and end, F_Z.
   struct StepLoads {
@@ -93,21 +108,44 @@ class SlipEventDetector {
     double shear_end = 0.0;    ///< N
     double normal = 0.0;       ///< N
   };
-  /// Call after every step (from step_start to step_start + dt) with the interface's new states.
-  /// Returns true when an event has just ended (then `events().back()` is it).
-  bool update(double step_start, double dt, const ContactInterface& contact, const Vector& u, const StepLoads& loads);
+  /// Call after every step (from step_start to step_start + dt) with the interface's new states and the
+  /// model's displacements `u` and velocities `v`. Returns true when an event has just ended (then
+  /// `events().back()` is it).
+  bool update(double step_start, double dt, const ContactInterface& contact, const Vector& u, const Vector& v,
+              const StepLoads& loads);
   bool inEvent() const { return in_event_; }
+  /// In the last update a node began slipping, or an event's quiet spell began (SlipCriterion).
+  bool slipChangedLastUpdate() const { return !began_.empty() || quiet_began_; }
   const std::vector<SlipEvent>& events() const { return events_; }
   int globalEventCount() const { return global_count_; }
 
  private:
-  void finish(double end_time, const Vector& u, double end_shear_force);
+  void finish();
+  /// Notes which nodes began and ceased slipping in the step, and when (SlipCriterion).
+  void watchSlip(double step_start, double dt, const ContactInterface& contact, const Vector& v);
 
   std::vector<double> positions_;
   std::vector<int> dofs_;
   int fit_nodes_;
   double longitudinal_speed_;
   double slider_length_;  ///< m, L
+  SlipCriterion criterion_;
+  // From the first moment of a quiet spell in the current event: what its end will be if it lasts.
+  double quiet_since_ = 0.0;  ///< s; NaN while a node slips
+  double quiet_step_end_ = 0.0;  ///< s, the end of the step it began in, from which it is timed (as the camera times it)
+  bool quiet_began_ = false;     ///< in the last update
+  double quiet_shear_force_ = 0.0;     ///< N, F_X then
+  double quiet_shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the event until then
+  double quiet_normal_impulse_ = 0.0;  ///< N·s
+  std::vector<double> quiet_u_;        ///< m, the interface's x displacements at the end of that step
+  // What watchSlip saw in the last step.
+  std::vector<int> began_;         ///< nodes that began slipping
+  std::vector<double> began_at_;   ///< s, per node: when it began, for the nodes in began_
+  std::size_t slipping_count_ = 0;  ///< nodes slipping at the step's end
+  double last_ceased_ = 0.0;       ///< s, when the last node that ceased slipping did; NaN if none did
+  // Past steps' speeds, for a criterion with a speed: the crossings interpolated within the step.
+  std::vector<double> slip_speed_;  ///< m/s, per node, |v| if sliding, else 0
+  std::vector<char> slipping_;      ///< per node
   bool in_event_ = false;
   SlipEvent current_;
   void notePeak(double shear_force);
@@ -144,6 +182,11 @@ struct WaveSpeeds {
   double rayleigh = 0.0;  ///< m/s, c_R of the lattice; 0 for the chain, which has no surface wave
 };
 WaveSpeeds waveSpeeds(const Scene& scene);
+
+/// The scene's: instruments.event_slip_speed and, with a speed, a quiet time of one shear-wave transit of
+/// the slider, L/c_S (145 µs for the PMMA slider): a front still running, or the slider still ringing
+/// from the same rupture, sets a node slipping again within it.
+SlipCriterion slipCriterion(const Scene& scene);
 
 /// An event's front speed in one number: the speed of the front that ran, not of the nucleation.
 struct FrontSpeedSummary {

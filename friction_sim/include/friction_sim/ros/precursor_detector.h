@@ -58,11 +58,13 @@ struct DetectorSettings {
   WaveSpeeds wave_speeds;      ///< m/s, the model's (all 0, unknown, without a scene)
   int front_fit_nodes = 5;     ///< the options' or the scene's
   double slider_length = 0.0;  ///< m, L of L_p/L: the scene's geometry.length; 0 without a scene
+  SlipCriterion slip;          ///< the scene's (slipCriterion); any sliding node, without a scene
   /// Whether the detector measures the same with `other`.
   bool sameAs(const DetectorSettings& other) const {
     return wave_speeds.longitudinal == other.wave_speeds.longitudinal && wave_speeds.shear == other.wave_speeds.shear &&
            wave_speeds.rayleigh == other.wave_speeds.rayleigh && front_fit_nodes == other.front_fit_nodes &&
-           slider_length == other.slider_length;
+           slider_length == other.slider_length && slip.speed == other.slip.speed &&
+           slip.quiet_time == other.slip.quiet_time;
   }
 };
 /// The settings from a run's `scene` (nullptr: none), with the ~front_fit_nodes option (0: the scene's).

@@ -82,10 +82,11 @@ class Simulation : public Dynamics {
   bool eventEndedLastStep() const { return event_ended_; }
   /// True if a slip event started in the last step.
   bool eventStartedLastStep() const { return event_started_; }
-  /// A node unstuck, or an event started or ended, in the last step: the steps the interface camera
-  /// must show, so that a detector reading only its frames sees every slip.
+  /// A node began slipping, an event's quiet spell began (SlipCriterion), or an event started or ended,
+  /// in the last step: the steps the interface camera must show, so that a detector reading only its
+  /// frames sees every slip and every end.
   bool interfaceChangedLastStep() const {
-    return event_started_ || event_ended_ || !contact_.unstuckLastStep().empty();
+    return event_started_ || event_ended_ || detector_.slipChangedLastUpdate();
   }
   /// True while a slip event is under way.
   bool inEvent() const { return detector_.inEvent(); }

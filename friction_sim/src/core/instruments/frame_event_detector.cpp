@@ -7,20 +7,18 @@
 
 namespace friction {
 
-namespace {
-bool anySliding(const InterfaceFrame& frame) {
-  return std::any_of(frame.state.begin(), frame.state.end(),
-                     [](std::uint8_t state) { return state == static_cast<std::uint8_t>(ContactState::Sliding); });
-}
-}  // namespace
-
-FrameEventDetector::FrameEventDetector(int front_fit_nodes, double longitudinal_speed, double slider_length)
-    : front_fit_nodes_(front_fit_nodes), longitudinal_speed_(longitudinal_speed), given_length_(slider_length) {}
+FrameEventDetector::FrameEventDetector(int front_fit_nodes, double longitudinal_speed, double slider_length,
+                                       SlipCriterion criterion)
+    : front_fit_nodes_(front_fit_nodes),
+      longitudinal_speed_(longitudinal_speed),
+      given_length_(slider_length),
+      criterion_(criterion) {}
 
 void FrameEventDetector::reset() {
   next_index_ = 0;
   load_cells_.clear();
   last_stuck_frame_.reset();
+  quiet_frame_.reset();
   in_event_ = false;
   ended_.clear();
   last_frame_time_ = -std::numeric_limits<double>::infinity();
@@ -87,10 +85,15 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   const std::size_t n = frame.position.size();
   last_frame_time_ = frame.time;
   if (n > 0) frames_length_ = frame.position.back();
-  const bool sliding = anySliding(frame);
+  std::vector<char> slipping(n);
+  for (std::size_t node = 0; node < n; ++node) {
+    const double velocity = node < frame.slip_velocity.size() ? frame.slip_velocity[node] : 0.0;
+    slipping[node] = criterion_.slipping(static_cast<ContactState>(frame.state[node]), velocity);
+  }
+  const bool any_slipping = std::find(slipping.begin(), slipping.end(), 1) != slipping.end();
   if (!in_event_) {
-    if (!sliding || !last_stuck_frame_ || last_stuck_frame_->position.size() != n) {
-      if (!sliding) last_stuck_frame_ = frame;
+    if (!any_slipping || !last_stuck_frame_ || last_stuck_frame_->position.size() != n) {
+      if (!any_slipping) last_stuck_frame_ = frame;
       return;
     }
     in_event_ = true;
@@ -102,7 +105,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
     double sum = 0.0;
     int count = 0;
     for (std::size_t node = 0; node < n; ++node) {
-      if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Sliding)) continue;
+      if (!slipping[node]) continue;
       sum += frame.position[node];
       ++count;
     }
@@ -110,23 +113,29 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   }
   for (std::size_t node = 0; node < n; ++node) {
     if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Detached)) in_contact_.touch(node);
-    if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) &&
-        std::isnan(current_.first_unstick_time[node])) {
+    if (slipping[node] && std::isnan(current_.first_unstick_time[node])) {
       current_.first_unstick_time[node] = frame.time;
     }
   }
-  if (sliding) return;
+  if (any_slipping) {
+    quiet_frame_.reset();
+    return;
+  }
+  if (!quiet_frame_) quiet_frame_ = frame;
+  if (frame.time - quiet_frame_->time < criterion_.quiet_time) return;
 
   in_event_ = false;
   SlipEvent event = std::move(current_);
-  event.end_time = frame.time;
+  const InterfaceFrame& end = *quiet_frame_;
+  event.end_time = end.time;
   event.node_slip.resize(n);
-  for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = frame.slip[node] - last_stuck_frame_->slip[node];
-  // The slipped nodes are those seen sliding, not merely moved: with an interfacial stiffness stuck
+  for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = end.slip[node] - last_stuck_frame_->slip[node];
+  // The slipped nodes are those seen slipping, not merely moved: with an interfacial stiffness stuck
   // nodes move elastically, and detached nodes move freely.
   measureExtent(event, frame.position, sliderLength(), in_contact_.count());
   measureFronts(event, frame.position, front_fit_nodes_, longitudinal_speed_);
   last_stuck_frame_ = frame;
+  quiet_frame_.reset();
   ended_.push_back(std::move(event));
 }
 

@@ -22,30 +22,72 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
 SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed,
-                                     double slider_length)
+                                     double slider_length, SlipCriterion criterion)
     : positions_(model.interfacePositions()),
       fit_nodes_(front_fit_nodes),
       longitudinal_speed_(longitudinal_speed),
-      slider_length_(slider_length) {
+      slider_length_(slider_length),
+      criterion_(criterion) {
   for (int node = 0; node < model.interfaceNodeCount(); ++node) dofs_.push_back(model.interfaceDof(node));
   onset_u_.resize(positions_.size());
+  began_at_.resize(positions_.size());
+  quiet_u_.resize(positions_.size());
+  slip_speed_.assign(positions_.size(), 0.0);
+  slipping_.assign(positions_.size(), 0);
+}
+
+void SlipEventDetector::watchSlip(double step_start, double dt, const ContactInterface& contact, const Vector& v) {
+  began_.clear();
+  last_ceased_ = kNaN;
+  auto note_ceased = [&](double time) { last_ceased_ = std::isnan(last_ceased_) ? time : std::max(last_ceased_, time); };
+  if (criterion_.speed <= 0.0) {
+    // Every sliding node slips: the interface's own transitions, at their times within the step.
+    auto transition_time = [&](int node) { return step_start + contact.transitionFraction(node) * dt; };
+    for (int node : contact.unstuckLastStep()) {
+      began_.push_back(node);
+      began_at_[node] = transition_time(node);
+    }
+    for (int node : contact.restuckLastStep()) note_ceased(transition_time(node));
+    slipping_count_ = static_cast<std::size_t>(contact.slidingCount());
+    return;
+  }
+  // Crossings of the speed, linear in time within the step.
+  slipping_count_ = 0;
+  auto crossing = [&](double from, double to) {
+    return to == from ? step_start + dt : step_start + std::clamp((criterion_.speed - from) / (to - from), 0.0, 1.0) * dt;
+  };
+  for (std::size_t node = 0; node < positions_.size(); ++node) {
+    const auto state = contact.state(static_cast<int>(node));
+    const double velocity = v[dofs_[node]];
+    const double speed = state == ContactState::Sliding ? std::abs(velocity) : 0.0;
+    const bool slipping = criterion_.slipping(state, velocity);
+    if (slipping && !slipping_[node]) {
+      began_.push_back(static_cast<int>(node));
+      began_at_[node] = crossing(slip_speed_[node], speed);
+    } else if (!slipping && slipping_[node]) {
+      note_ceased(crossing(slip_speed_[node], speed));
+    }
+    slip_speed_[node] = speed;
+    slipping_[node] = slipping;
+    slipping_count_ += slipping;
+  }
 }
 
 bool SlipEventDetector::update(double step_start, double dt, const ContactInterface& contact, const Vector& u,
-                               const StepLoads& loads) {
-  const auto& unstuck = contact.unstuckLastStep();
-  auto transition_time = [&](int node) { return step_start + contact.transitionFraction(node) * dt; };
+                               const Vector& v, const StepLoads& loads) {
+  watchSlip(step_start, dt, contact, v);
+  quiet_began_ = false;
   auto shear_at = [&](double time) {
     if (dt <= 0.0) return loads.shear_end;
     return loads.shear_start + (loads.shear_end - loads.shear_start) * (time - step_start) / dt;
   };
-  if (!in_event_ && !unstuck.empty()) {
+  if (!in_event_ && !began_.empty()) {
     in_event_ = true;
     const std::size_t n = positions_.size();
     current_ = SlipEvent{};
     current_.index = static_cast<int>(events_.size());
     current_.onset_time = step_start + dt;
-    for (int node : unstuck) current_.onset_time = std::min(current_.onset_time, transition_time(node));
+    for (int node : began_) current_.onset_time = std::min(current_.onset_time, began_at_[node]);
     current_.onset_shear_force = shear_at(current_.onset_time);
     current_.peak_shear_force = current_.onset_shear_force;
     slipped_ = 0;
@@ -53,10 +95,11 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     current_.onset_normal_force = loads.normal;
     shear_impulse_ = 0.0;
     normal_impulse_ = 0.0;
+    quiet_since_ = kNaN;
     current_.first_unstick_time.assign(n, kNaN);
     double sum = 0.0;
-    for (int node : unstuck) sum += positions_[node];
-    current_.nucleation_position = sum / unstuck.size();
+    for (int node : began_) sum += positions_[node];
+    current_.nucleation_position = sum / began_.size();
     // Slip counts from where the nodes were before this step, including what unsticking caught up.
     for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
   }
@@ -65,31 +108,47 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
                    [&contact](std::size_t node) { return contact.state(static_cast<int>(node)); });
   const bool was_global = slipped_ == in_contact_.count();
   double last_first_unstick = step_start;  // of the nodes slipping for the first time in this step
-  for (int node : unstuck) {
+  for (int node : began_) {
     if (!std::isnan(current_.first_unstick_time[node])) continue;
-    current_.first_unstick_time[node] = transition_time(node);
+    current_.first_unstick_time[node] = began_at_[node];
     last_first_unstick = std::max(last_first_unstick, current_.first_unstick_time[node]);
     ++slipped_;
     in_contact_.touch(static_cast<std::size_t>(node));
   }
-  const bool ended = contact.slidingCount() == 0;
-  double end_time = step_start + dt;
-  if (ended && !contact.restuckLastStep().empty()) {
-    end_time = step_start;
-    for (int node : contact.restuckLastStep()) end_time = std::max(end_time, transition_time(node));
+  const double step_end = step_start + dt;
+  const bool quiet_before = !std::isnan(quiet_since_);
+  if (slipping_count_ > 0) {
+    quiet_since_ = kNaN;
+  } else if (!quiet_before) {
+    quiet_since_ = std::isnan(last_ceased_) ? step_end : std::max(step_start, last_ceased_);
   }
+  const bool quiet_began = !quiet_before && !std::isnan(quiet_since_);
+  quiet_began_ = quiet_began;
+  // The part of the step up to where a quiet spell begins, or all of it: the event's end, if the spell lasts.
+  const double watch_end = quiet_began ? quiet_since_ : step_end;
   // The peak is watched until the whole interface has slipped. F_X is linear across the step, so its
   // value where this step's part of the watch ends bounds it (the start was noted at the onset or by
   // the step before).
-  if (!was_global) notePeak(shear_at(slipped_ == in_contact_.count() ? last_first_unstick : end_time));
-  // The part of this step inside the event, F_X linear across the step as in shear_at.
+  if (!was_global && !quiet_before) notePeak(shear_at(slipped_ == in_contact_.count() ? last_first_unstick : watch_end));
+  // The step inside the event, F_X linear across it as in shear_at; a quiet spell's part is counted
+  // apart, for the event goes on if a node slips again.
+  auto add_impulse = [&](double from, double to) {
+    if (to <= from) return;
+    shear_impulse_ += 0.5 * (shear_at(from) + shear_at(to)) * (to - from);
+    normal_impulse_ += loads.normal * (to - from);
+  };
   const double from = std::max(step_start, current_.onset_time);
-  if (end_time > from) {
-    shear_impulse_ += 0.5 * (shear_at(from) + shear_at(end_time)) * (end_time - from);
-    normal_impulse_ += loads.normal * (end_time - from);
+  add_impulse(from, watch_end);
+  if (quiet_began) {
+    quiet_step_end_ = step_end;
+    quiet_shear_force_ = shear_at(quiet_since_);
+    quiet_shear_impulse_ = shear_impulse_;
+    quiet_normal_impulse_ = normal_impulse_;
+    for (std::size_t node = 0; node < quiet_u_.size(); ++node) quiet_u_[node] = u[dofs_[node]];
+    add_impulse(std::max(from, watch_end), step_end);
   }
-  if (!ended) return false;
-  finish(end_time, u, shear_at(end_time));
+  if (std::isnan(quiet_since_) || step_end - quiet_step_end_ < criterion_.quiet_time) return false;
+  finish();
   return true;
 }
 
@@ -97,17 +156,17 @@ void SlipEventDetector::notePeak(double shear_force) {
   if (std::abs(shear_force) > std::abs(current_.peak_shear_force)) current_.peak_shear_force = shear_force;
 }
 
-void SlipEventDetector::finish(double end_time, const Vector& u, double end_shear_force) {
+void SlipEventDetector::finish() {
   in_event_ = false;
   SlipEvent& event = current_;
-  event.end_time = end_time;
-  event.end_shear_force = end_shear_force;
-  const double duration = end_time - event.onset_time;
-  event.mean_shear_force = duration > 0.0 ? shear_impulse_ / duration : event.onset_shear_force;
-  event.mean_normal_force = duration > 0.0 ? normal_impulse_ / duration : event.onset_normal_force;
+  event.end_time = quiet_since_;
+  event.end_shear_force = quiet_shear_force_;
+  const double duration = event.end_time - event.onset_time;
+  event.mean_shear_force = duration > 0.0 ? quiet_shear_impulse_ / duration : event.onset_shear_force;
+  event.mean_normal_force = duration > 0.0 ? quiet_normal_impulse_ / duration : event.onset_normal_force;
   const std::size_t n = positions_.size();
   event.node_slip.resize(n);
-  for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = u[dofs_[node]] - onset_u_[node];
+  for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = quiet_u_[node] - onset_u_[node];
   measureExtent(event, positions_, slider_length_, in_contact_.count());
   measureFronts(event, positions_, fit_nodes_, longitudinal_speed_);
   if (event.global) ++global_count_;
@@ -152,6 +211,11 @@ namespace {
 /// c_R/c_S for the lattice's ν = 1/3 (MODEL.md §2), the root of the Rayleigh equation.
 constexpr double kRayleighFraction = 0.919;
 }  // namespace
+
+SlipCriterion slipCriterion(const Scene& scene) {
+  const double speed = scene.instruments.event_slip_speed;
+  return {speed, speed > 0.0 ? scene.geometry.length / waveSpeeds(scene).shear : 0.0};
+}
 
 WaveSpeeds waveSpeeds(const Scene& scene) {
   const double E = scene.material.youngs_modulus, rho = scene.material.density;

@@ -235,7 +235,7 @@ void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   s.refreshAfterStaticChange();
   // Round-off may land a node just past its threshold: then its slip starts here.
   const ForceEvaluation& end = s.evaluation_;
-  s.detector_.update(s.time_, 0.0, s.contact_, s.u_, {end.shear_force, end.shear_force, end.normal_load});
+  s.detector_.update(s.time_, 0.0, s.contact_, s.u_, s.v_, {end.shear_force, end.shear_force, end.normal_load});
   s.ledger_.addPusherWork(shear_start, end.shear_force, stage_start, stage_end);
   ++jumps_;
   // Any approach before this jump is over: the crossing, if it comes, is found again from here.

@@ -25,7 +25,8 @@ Simulation::Simulation(const Scene& scene, double stability_limit)
       contact_(buildFrictionLaw(scene_.friction), *model_, scene_.friction.interfacial_stiffness),
       integrator_(buildIntegrator(scene_.integrator.scheme)),
       stage_(scene_.stage, scene_.integrator.time_step),
-      detector_(*model_, scene_.instruments.front_fit_nodes, waveSpeeds(scene_).longitudinal, scene_.geometry.length),
+      detector_(*model_, scene_.instruments.front_fit_nodes, waveSpeeds(scene_).longitudinal, scene_.geometry.length,
+                slipCriterion(scene_)),
       dt_(scene_.integrator.time_step),
       stability_limit_(stability_limit),
       node_mass_(model_->nodeMass()),
@@ -124,7 +125,7 @@ void Simulation::settleInterface() {
 
 void Simulation::concludeStep(const StepStart& start) {
   const bool was_in_event = detector_.inEvent();
-  event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_,
+  event_ended_ = detector_.update(time_ - dt_, dt_, contact_, u_, v_,
                                   {start.shear_force, evaluation_.shear_force, evaluation_.normal_load});
   event_started_ = !was_in_event && (detector_.inEvent() || event_ended_);
   if (scene_.integrator.fast_forward) {

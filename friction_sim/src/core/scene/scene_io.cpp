@@ -138,6 +138,7 @@ void visitRig(Scene& s, Visitor& v) {
     v.field("gauge_height", s.instruments.gauge_height);
     v.field("gauge_positions", s.instruments.gauge_positions);
     v.field("front_fit_nodes", s.instruments.front_fit_nodes);
+    v.field("event_slip_speed", s.instruments.event_slip_speed);
   });
   v.section("stop", [&] {
     v.field("global_events", s.stop.global_events);
