@@ -61,6 +61,9 @@ TEST_P(SingleBlockStickSlip, MatchesTheClosedFormCycle) {
     EXPECT_NEAR(direction * event.mean_shear_force, mu_k * normal, 1e-6 * mu_k * normal);
     // A sum over ~10⁵ steps: round-off of about 10⁵ × 1.1e-16.
     EXPECT_NEAR(event.mean_normal_force, normal, 1e-9 * normal);
+    // Released from rest at µ_s·N, the block's speed is V + ωΔ·sin ωt − V·cos ωt: its peak V + √((ωΔ)² + V²).
+    const double peak_speed = speed + std::hypot(omega * delta, speed);
+    EXPECT_NEAR(event.peak_slip_velocity[0], peak_speed, 1e-6 * peak_speed);
     const double slip_per_cycle = speed * slip_time + 2.0 * delta;
     EXPECT_NEAR(direction * event.node_slip[0], slip_per_cycle, 1e-6 * slip_per_cycle);
     if (e + 1 < events.size()) {

@@ -44,6 +44,9 @@ struct SlipEvent {
   std::vector<double> node_slip;           ///< m, per interface node, displacement during the event
   std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
   std::vector<double> front_speed;         ///< m/s, v_c per node from the first-unstick times; NaN where undefined
+  /// m/s, per node, the largest slip speed |dx/dt| it slid at during the event (0 where it did not
+  /// slide): the slip velocity behind the front, which the experiments find proportional to v_c
+  std::vector<double> peak_slip_velocity;
   double median_front_speed = std::numeric_limits<double>::quiet_NaN();  ///< m/s, summarizeFrontSpeeds; NaN: none
   int front_fits_left_out = 0;  ///< fits left out of that median (summarizeFrontSpeeds)
   /// m, mean slip of the nodes that slipped (NaN if none did); negative for a back-slip.

@@ -101,6 +101,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
     current_.index = next_index_++;
     current_.onset_time = frame.time;
     current_.first_unstick_time.assign(n, std::numeric_limits<double>::quiet_NaN());
+    current_.peak_slip_velocity.assign(n, 0.0);
     in_contact_.start(n);
     double sum = 0.0;
     int count = 0;
@@ -113,6 +114,9 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   }
   for (std::size_t node = 0; node < n; ++node) {
     if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Detached)) in_contact_.touch(node);
+    if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) && node < frame.slip_velocity.size()) {
+      current_.peak_slip_velocity[node] = std::max(current_.peak_slip_velocity[node], std::abs(frame.slip_velocity[node]));
+    }
     if (slipping[node] && std::isnan(current_.first_unstick_time[node])) {
       current_.first_unstick_time[node] = frame.time;
     }

@@ -89,12 +89,12 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
 
 void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,
                         const std::vector<double>& node_positions) {
-  out << "event,node,x_m,slip_m,first_unstick_time_s,front_speed_m_s\n";
+  out << "event,node,x_m,slip_m,first_unstick_time_s,front_speed_m_s,peak_slip_velocity_m_s\n";
   out << std::setprecision(12);
   for (const SlipEvent& e : events) {
     for (std::size_t node = 0; node < node_positions.size(); ++node) {
       out << e.index << ',' << node << ',' << node_positions[node] << ',' << e.node_slip[node] << ','
-          << e.first_unstick_time[node] << ',' << e.front_speed[node] << '\n';
+          << e.first_unstick_time[node] << ',' << e.front_speed[node] << ',' << e.peak_slip_velocity[node] << '\n';
     }
   }
 }

@@ -97,6 +97,7 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     normal_impulse_ = 0.0;
     quiet_since_ = kNaN;
     current_.first_unstick_time.assign(n, kNaN);
+    current_.peak_slip_velocity.assign(n, 0.0);
     double sum = 0.0;
     for (int node : began_) sum += positions_[node];
     current_.nucleation_position = sum / began_.size();
@@ -104,6 +105,11 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
     for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
   }
   if (!in_event_) return false;
+  for (std::size_t node = 0; node < positions_.size(); ++node) {
+    if (contact.state(static_cast<int>(node)) != ContactState::Sliding) continue;
+    double& peak = current_.peak_slip_velocity[node];
+    peak = std::max(peak, std::abs(v[dofs_[node]]));
+  }
   in_contact_.note(static_cast<std::size_t>(contact.detachedCount()),
                    [&contact](std::size_t node) { return contact.state(static_cast<int>(node)); });
   const bool was_global = slipped_ == in_contact_.count();
