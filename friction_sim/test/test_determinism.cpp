@@ -23,7 +23,7 @@ struct Pin {
 constexpr Pin kPins[] = {
     {"single_block", 0xe1ac1a59a82fec52ULL}, {"pmma_1d_side", 0x1134ed5206e1b6ccULL},
     {"pmma_1d_top", 0x556f54bc1cb604d3ULL},  {"pmma_2d", 0xe8c93851ef6a52e9ULL},
-    {"rate_state", 0xff1a9852884f553eULL},
+    {"rate_state", 0x3ea5e3ef44d77e9dULL},
 };
 
 void PrintTo(const Pin& pin, std::ostream* out) { *out << pin.scene; }

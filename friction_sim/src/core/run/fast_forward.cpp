@@ -175,25 +175,28 @@ void FastForward::findFirstCrossing(Path& path, const ForceEvaluation& here, con
       const double slope = sign * force_rate - mu * normal_rate;
       if (!(slope > 0.0)) continue;
       const double crossing = (mu * normal - sign * force) / slope;
-      stop_at(ageing ? agedCrossing(node, sign, force, force_rate, normal, normal_rate, crossing, path.length)
-                     : crossing);
+      stop_at(ageing ? agedCrossing(node, sign, force, force_rate, normal, normal_rate, crossing) : crossing);
     }
     if (normal_rate < 0.0) stop_at(-normal / normal_rate);
   }
 }
 
 double FastForward::agedCrossing(int node, double sign, double force, double force_rate, double normal,
-                                 double normal_rate, double earliest, double latest) const {
+                                 double normal_rate, double earliest) const {
   const FrictionLaw& law = sim_.contact_.law();
   auto margin = [&](double t) {
     return law.staticCoefficientAfter(node, t) * (normal + normal_rate * t) - sign * (force + force_rate * t);
   };
-  // The strength rises as the logarithm of the age, the load linearly: the margin falls through zero once.
-  // Scanned in even parts, a crossing is bracketed, then halved down to round-off.
-  constexpr int kParts = 64;
+  // The strength rises as the logarithm of the age, the load linearly: the margin falls through zero once,
+  // after `earliest`. Bracketed in steps that double from a scale of `earliest`, then halved down to
+  // round-off. Not on a scale of the jump: a crossing must not depend on where a caller ends its jump (a
+  // live run ends its jumps where commands are due, an offline run where it stops).
+  constexpr double kShortestScale = 1e-9;  // s, for a node at its threshold now (earliest = 0)
+  constexpr int kMostDoublings = 200;
   double low = std::max(earliest, 0.0);
-  for (int part = 1; part <= kParts && low < latest; ++part) {
-    double high = low + (latest - low) / (kParts + 1 - part);
+  double step = std::max(low, kShortestScale) / 64;
+  for (int doubling = 0; doubling < kMostDoublings; ++doubling, step *= 2) {
+    double high = low + step;
     if (margin(high) >= 0.0) {
       low = high;
       continue;

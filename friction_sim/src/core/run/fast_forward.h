@@ -61,9 +61,9 @@ class FastForward {
                          double probe);
   /// s, for a law that ages: when the stuck `node`'s load sign·(force + force_rate·t) first reaches its
   /// rising strength µ_s(t)·(normal + normal_rate·t), searched from `earliest` (the crossing with µ_s
-  /// as it is now, which cannot come later) to `latest`; inf if not before `latest`.
+  /// as it is now, before which it cannot come); inf if the load never reaches it.
   double agedCrossing(int node, double sign, double force, double force_rate, double normal, double normal_rate,
-                      double earliest, double latest) const;
+                      double earliest) const;
   /// Moves the slider and the stage along `path` by its length, the clock to `end_time` (s).
   void takeJump(StaticSolver& solver, Path& path, double end_time);
   /// Share of the way to an estimated threshold crossing that one jump covers.
