@@ -135,7 +135,10 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
   // The peak is watched until the whole interface has slipped. F_X is linear across the step, so its
   // value where this step's part of the watch ends bounds it (the start was noted at the onset or by
   // the step before).
-  if (!was_global && !quiet_before) notePeak(shear_at(slipped_ == in_contact_.count() ? last_first_unstick : watch_end));
+  const bool quiet_throughout = quiet_before && !std::isnan(quiet_since_);
+  if (!was_global && !quiet_throughout) {
+    notePeak(shear_at(slipped_ == in_contact_.count() ? last_first_unstick : watch_end));
+  }
   // The step inside the event, F_X linear across it as in shear_at; a quiet spell's part is counted
   // apart, for the event goes on if a node slips again.
   auto add_impulse = [&](double from, double to) {
