@@ -34,6 +34,7 @@ slow=(
   BothIntegratorsBothDirections/SingleBlockStickSlip.MatchesTheClosedFormCycle/5
   RateStateBlock.SteadySlidingFollowsTheSteadyStateCurveOverSixDecadesOfSpeed
   RateStateBlock.VelocityStepJumpsByTheDirectEffectThenEvolvesOverTheCharacteristicSlip
+  FrameEventDetector.RateStateEventsEndOnTheirSlipSpeedWhileTheInterfaceCreeps
 )
 filter="-$(IFS=:; echo "${slow[*]}")"
 # -O1 with line tables: a quick build, and reports that name the line.
