@@ -6,6 +6,7 @@
 SWEEP.yaml names a base scene, fixed overrides and the parameters to vary:
 
     base: friction_sim/scenes/pmma_2d.yaml       # relative to the repository
+    protocol: friction_sim/protocols/stop_and_go.yaml  # optional: every run follows it (--protocol)
     set: {stop.global_events: 1}                  # applied to every run
     vary:                                         # every combination runs
       load.normal_force: [1000, 1920, 4000]
@@ -45,10 +46,11 @@ def load(path):
     except (OSError, yaml.YAMLError) as error:
         sys.exit("sweep: %s cannot be read: %s" % (path, error))
     if not isinstance(spec, dict):
-        sys.exit("sweep: %s: expected a mapping with base (required), set, vary, cases" % path)
-    unknown = set(spec) - {"base", "set", "vary", "cases"}
+        sys.exit("sweep: %s: expected a mapping with base (required), protocol, set, vary, cases" % path)
+    unknown = set(spec) - {"base", "protocol", "set", "vary", "cases"}
     if unknown or "base" not in spec:
-        sys.exit("sweep: %s: keys allowed are base (required), set, vary, cases; got %s" % (path, sorted(spec)))
+        sys.exit("sweep: %s: keys allowed are base (required), protocol, set, vary, cases; got %s" % (
+            path, sorted(spec)))
     return spec
 
 
@@ -70,6 +72,8 @@ def run_id(point):
 def command(spec, point, out_dir):
     """The shell command of one run: friction_run with the sweep's overrides, its output logged."""
     args = [RUNNER, os.path.join(ROOT, spec["base"]), "--out", out_dir]
+    if "protocol" in spec:
+        args += ["--protocol", os.path.join(ROOT, spec["protocol"])]
     for name, value in list((spec.get("set") or {}).items()) + list(point.items()):
         # Strings are YAML already (e.g. a stage program); numbers and booleans are written as YAML.
         text = value if isinstance(value, str) else yaml.safe_dump(value, default_flow_style=True)

@@ -54,6 +54,18 @@ class SweepTest(unittest.TestCase):
                 self.assertAlmostEqual(float(event["onset_shear_force_N"]), STATIC_COEFFICIENT * normal_force,
                                        delta=1e-9 * normal_force)
 
+    def test_every_run_follows_the_sweeps_protocol(self):
+        # The protocol drives the block at 4 mm/s and ends after two global events; the scene alone would
+        # stop after three.
+        path = os.path.join(self.work, "protocol.yaml")
+        with open(path, "w") as handle:
+            handle.write("base: friction_sim/scenes/single_block.yaml\n"
+                         "protocol: friction_sim/test/protocols/two_global_events.yaml\n"
+                         "vary: {load.normal_force: [1000, 2000]}\n")
+        rows, failed = sweep.run(path, jobs=2, out=os.path.join(self.work, "out"))
+        self.assertEqual(failed, [])
+        self.assert_onsets_follow_amontons(rows, [1000, 2000])
+
     def test_a_refused_run_is_reported_and_the_others_are_kept(self):
         out = os.path.join(self.work, "out")
         with mock.patch("sys.stderr", new_callable=io.StringIO) as errors:
