@@ -110,6 +110,10 @@ class SlipEventDetector {
     double shear_start = 0.0;  ///< N
     double shear_end = 0.0;    ///< N
     double normal = 0.0;       ///< N
+    /// N, F_X at `time` (s) of the step from `step_start` (s) of `dt` (s), linear across it
+    double shearAt(double time, double step_start, double dt) const {
+      return dt <= 0.0 ? shear_end : shear_start + (shear_end - shear_start) * (time - step_start) / dt;
+    }
   };
   /// Call after every step (from step_start to step_start + dt) with the interface's new states and the
   /// model's displacements `u` and velocities `v`. Returns true when an event has just ended (then
@@ -123,6 +127,9 @@ class SlipEventDetector {
   int globalEventCount() const { return global_count_; }
 
  private:
+  /// Starts an event at the step's earliest onset of slip among began_.
+  void startEvent(double step_start, double dt, const ContactInterface& contact, const Vector& u,
+                  const StepLoads& loads);
   void finish();
   /// Notes which nodes began and ceased slipping in the step, and when (SlipCriterion).
   void watchSlip(double step_start, double dt, const ContactInterface& contact, const Vector& v);

@@ -73,37 +73,37 @@ void SlipEventDetector::watchSlip(double step_start, double dt, const ContactInt
   }
 }
 
+void SlipEventDetector::startEvent(double step_start, double dt, const ContactInterface& contact, const Vector& u,
+                                   const StepLoads& loads) {
+  in_event_ = true;
+  const std::size_t n = positions_.size();
+  current_ = SlipEvent{};
+  current_.index = static_cast<int>(events_.size());
+  current_.onset_time = step_start + dt;
+  for (int node : began_) current_.onset_time = std::min(current_.onset_time, began_at_[node]);
+  current_.onset_shear_force = loads.shearAt(current_.onset_time, step_start, dt);
+  current_.peak_shear_force = current_.onset_shear_force;
+  slipped_ = 0;
+  in_contact_.start(n);
+  current_.onset_normal_force = loads.normal;
+  shear_impulse_ = 0.0;
+  normal_impulse_ = 0.0;
+  quiet_since_ = kNaN;
+  current_.first_unstick_time.assign(n, kNaN);
+  current_.peak_slip_velocity.assign(n, 0.0);
+  double sum = 0.0;
+  for (int node : began_) sum += positions_[node];
+  current_.nucleation_position = sum / began_.size();
+  // Slip counts from where the nodes were before this step, including what unsticking caught up.
+  for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
+}
+
 bool SlipEventDetector::update(double step_start, double dt, const ContactInterface& contact, const Vector& u,
                                const Vector& v, const StepLoads& loads) {
   watchSlip(step_start, dt, contact, v);
   quiet_began_ = false;
-  auto shear_at = [&](double time) {
-    if (dt <= 0.0) return loads.shear_end;
-    return loads.shear_start + (loads.shear_end - loads.shear_start) * (time - step_start) / dt;
-  };
-  if (!in_event_ && !began_.empty()) {
-    in_event_ = true;
-    const std::size_t n = positions_.size();
-    current_ = SlipEvent{};
-    current_.index = static_cast<int>(events_.size());
-    current_.onset_time = step_start + dt;
-    for (int node : began_) current_.onset_time = std::min(current_.onset_time, began_at_[node]);
-    current_.onset_shear_force = shear_at(current_.onset_time);
-    current_.peak_shear_force = current_.onset_shear_force;
-    slipped_ = 0;
-    in_contact_.start(n);
-    current_.onset_normal_force = loads.normal;
-    shear_impulse_ = 0.0;
-    normal_impulse_ = 0.0;
-    quiet_since_ = kNaN;
-    current_.first_unstick_time.assign(n, kNaN);
-    current_.peak_slip_velocity.assign(n, 0.0);
-    double sum = 0.0;
-    for (int node : began_) sum += positions_[node];
-    current_.nucleation_position = sum / began_.size();
-    // Slip counts from where the nodes were before this step, including what unsticking caught up.
-    for (std::size_t node = 0; node < n; ++node) onset_u_[node] = contact.stepStartPosition(static_cast<int>(node), u);
-  }
+  auto shear_at = [&](double time) { return loads.shearAt(time, step_start, dt); };
+  if (!in_event_ && !began_.empty()) startEvent(step_start, dt, contact, u, loads);
   if (!in_event_) return false;
   for (std::size_t node = 0; node < positions_.size(); ++node) {
     if (contact.state(static_cast<int>(node)) != ContactState::Sliding) continue;
