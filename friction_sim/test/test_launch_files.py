@@ -59,6 +59,13 @@ class LaunchFilesTest(unittest.TestCase):
         self.check_rviz_follows(load("rig.launch", "rviz:=true"), "rig")
         self.check_rviz_follows(load("playback.launch", "bag:=/tmp/run.bag", "ns:=replay", "rviz:=true"), "replay")
 
+    def test_two_recording_rigs_write_two_bags_by_default(self):
+        for launch_file in ["rig.launch", "multi_machine.launch"]:
+            args = ["record:=true"] + (["compute_host:=hpc1", "compute_env:=/x"] if "multi" in launch_file else [])
+            first, second = (load(launch_file, *args).params["/rig/simulator/bag"].value for _ in range(2))
+            self.assertTrue(first.startswith("/tmp/friction_rig") and first.endswith(".bag"), first)
+            self.assertNotEqual(first, second, launch_file)
+
     def test_multi_machine_runs_the_simulator_remotely_with_every_rig_argument(self):
         config = load("multi_machine.launch", "compute_host:=hpc1", "compute_env:=/opt/rig/scripts/ros_env_loader.sh",
                       "overrides:=pusher.height=0.01", "record:=true", "bag:=/scratch/run.bag",
