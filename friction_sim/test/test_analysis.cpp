@@ -418,8 +418,8 @@ TEST(FrameEventDetector, RateStateEventsEndOnTheirSlipSpeedWhileTheInterfaceCree
   Simulation simulation(scene);
   const SlipCriterion criterion = slipCriterion(scene);
   ASSERT_GT(criterion.speed, 0.0);
-  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal,
-                              scene.geometry.length, criterion);
+  FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal, scene.geometry.length,
+                              criterion);
   int most_sliding_at_an_end = 0;
   const std::vector<SlipEvent> found = eventsSeenByTheInstruments(simulation, detector, [&] {
     if (simulation.eventEndedLastStep()) {

@@ -3,8 +3,8 @@
 // frame with a slipping node (SlipCriterion) after a frame with none and ends at the next frame with
 // none, once the frames show none for the criterion's quiet time; the slipped nodes are those seen
 // slipping in between. The simulator publishes a frame at every
-// step where a node begins slipping and where an event ends, so the camera misses no node's slip and no event, provided that
-// every frame arrives (a frame lost, or a bag recorded before that rule, can hide a short slip).
+// step where a node begins slipping and where an event ends, so the camera misses no node's slip and no event, provided
+// that every frame arrives (a frame lost, or a bag recorded before that rule, can hide a short slip).
 #pragma once
 
 #include <deque>
@@ -45,7 +45,7 @@ class FrameEventDetector {
   void addLoadCellsTo(SlipEvent& event) const;
   int front_fit_nodes_;
   double longitudinal_speed_;
-  double given_length_;         ///< m, L from the run's scene; 0 unknown
+  double given_length_;  ///< m, L from the run's scene; 0 unknown
   SlipCriterion criterion_;
   double frames_length_ = 0.0;  ///< m, the last interface node's x in the frames
   double last_frame_time_ = -std::numeric_limits<double>::infinity();

@@ -142,17 +142,18 @@ class SlipEventDetector {
   SlipCriterion criterion_;
   // From the first moment of a quiet spell in the current event: what its end will be if it lasts.
   double quiet_since_ = 0.0;  ///< s; NaN while a node slips
-  double quiet_step_end_ = 0.0;  ///< s, the end of the step it began in, from which it is timed (as the camera times it)
-  bool quiet_began_ = false;     ///< in the last update
+  double quiet_step_end_ =
+      0.0;                    ///< s, the end of the step it began in, from which it is timed (as the camera times it)
+  bool quiet_began_ = false;  ///< in the last update
   double quiet_shear_force_ = 0.0;     ///< N, F_X then
   double quiet_shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the event until then
   double quiet_normal_impulse_ = 0.0;  ///< N·s
   std::vector<double> quiet_u_;        ///< m, the interface's x displacements at the end of that step
   // What watchSlip saw in the last step.
-  std::vector<int> began_;         ///< nodes that began slipping
-  std::vector<double> began_at_;   ///< s, per node: when it began, for the nodes in began_
+  std::vector<int> began_;          ///< nodes that began slipping
+  std::vector<double> began_at_;    ///< s, per node: when it began, for the nodes in began_
   std::size_t slipping_count_ = 0;  ///< nodes slipping at the step's end
-  double last_ceased_ = 0.0;       ///< s, when the last node that ceased slipping did; NaN if none did
+  double last_ceased_ = 0.0;        ///< s, when the last node that ceased slipping did; NaN if none did
   // Past steps' speeds, for a criterion with a speed: the crossings interpolated within the step.
   std::vector<double> slip_speed_;  ///< m/s, per node, |v| if sliding, else 0
   std::vector<char> slipping_;      ///< per node

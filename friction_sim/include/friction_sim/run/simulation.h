@@ -85,9 +85,7 @@ class Simulation : public Dynamics {
   /// A node began slipping, an event's quiet spell began (SlipCriterion), or an event started or ended,
   /// in the last step: the steps the interface camera must show, so that a detector reading only its
   /// frames sees every slip and every end.
-  bool interfaceChangedLastStep() const {
-    return event_started_ || event_ended_ || detector_.slipChangedLastUpdate();
-  }
+  bool interfaceChangedLastStep() const { return event_started_ || event_ended_ || detector_.slipChangedLastUpdate(); }
   /// True while a slip event is under way.
   bool inEvent() const { return detector_.inEvent(); }
   int globalEventCount() const { return detector_.globalEventCount(); }

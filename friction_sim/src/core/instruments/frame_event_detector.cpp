@@ -115,7 +115,8 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   for (std::size_t node = 0; node < n; ++node) {
     if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Detached)) in_contact_.touch(node);
     if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) && node < frame.slip_velocity.size()) {
-      current_.peak_slip_velocity[node] = std::max(current_.peak_slip_velocity[node], std::abs(frame.slip_velocity[node]));
+      current_.peak_slip_velocity[node] =
+          std::max(current_.peak_slip_velocity[node], std::abs(frame.slip_velocity[node]));
     }
     if (slipping[node] && std::isnan(current_.first_unstick_time[node])) {
       current_.first_unstick_time[node] = frame.time;

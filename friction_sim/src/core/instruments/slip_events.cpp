@@ -39,7 +39,9 @@ SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, do
 void SlipEventDetector::watchSlip(double step_start, double dt, const ContactInterface& contact, const Vector& v) {
   began_.clear();
   last_ceased_ = kNaN;
-  auto note_ceased = [&](double time) { last_ceased_ = std::isnan(last_ceased_) ? time : std::max(last_ceased_, time); };
+  auto note_ceased = [&](double time) {
+    last_ceased_ = std::isnan(last_ceased_) ? time : std::max(last_ceased_, time);
+  };
   if (criterion_.speed <= 0.0) {
     // Every sliding node slips: the interface's own transitions, at their times within the step.
     auto transition_time = [&](int node) { return step_start + contact.transitionFraction(node) * dt; };
@@ -54,7 +56,8 @@ void SlipEventDetector::watchSlip(double step_start, double dt, const ContactInt
   // Crossings of the speed, linear in time within the step.
   slipping_count_ = 0;
   auto crossing = [&](double from, double to) {
-    return to == from ? step_start + dt : step_start + std::clamp((criterion_.speed - from) / (to - from), 0.0, 1.0) * dt;
+    return to == from ? step_start + dt
+                      : step_start + std::clamp((criterion_.speed - from) / (to - from), 0.0, 1.0) * dt;
   };
   for (std::size_t node = 0; node < positions_.size(); ++node) {
     const auto state = contact.state(static_cast<int>(node));

@@ -187,7 +187,8 @@ void checkInstrumentsStopAndIntegrator(Checker& check, const Scene& s) {
   check.require(s.instruments.front_fit_nodes >= 2, "instruments.front_fit_nodes", s.instruments.front_fit_nodes,
                 "an integer >= 2");
   check.require(std::isfinite(s.instruments.event_slip_speed) && s.instruments.event_slip_speed >= 0.0,
-                "instruments.event_slip_speed", s.instruments.event_slip_speed, "a finite speed >= 0 m/s (0: any sliding)");
+                "instruments.event_slip_speed", s.instruments.event_slip_speed,
+                "a finite speed >= 0 m/s (0: any sliding)");
   check.require(s.stop.global_events >= 0, "stop.global_events", s.stop.global_events, "an integer >= 0");
   // ∞ allowed, as set_run_end allows it: the rig publishes and records its scene with the run's end.
   check.require(s.stop.time > 0.0, "stop.time", s.stop.time, "a time > 0 s (.inf allowed)");
