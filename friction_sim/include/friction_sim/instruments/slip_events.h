@@ -156,7 +156,6 @@ class SlipEventDetector {
   double last_ceased_ = 0.0;        ///< s, when the last node that ceased slipping did; NaN if none did
   // Past steps' speeds, for a criterion with a speed: the crossings interpolated within the step.
   std::vector<double> slip_speed_;  ///< m/s, per node, |v| if sliding, else 0
-  std::vector<char> slipping_;      ///< per node
   bool in_event_ = false;
   SlipEvent current_;
   void notePeak(double shear_force);

@@ -86,9 +86,12 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   last_frame_time_ = frame.time;
   if (n > 0) frames_length_ = frame.position.back();
   std::vector<char> slipping(n);
+  std::vector<double> sliding_speed(n, 0.0);  // m/s, |v| of the sliding nodes
   for (std::size_t node = 0; node < n; ++node) {
+    const auto state = static_cast<ContactState>(frame.state[node]);
     const double velocity = node < frame.slip_velocity.size() ? frame.slip_velocity[node] : 0.0;
-    slipping[node] = criterion_.slipping(static_cast<ContactState>(frame.state[node]), velocity);
+    slipping[node] = criterion_.slipping(state, velocity);
+    if (state == ContactState::Sliding) sliding_speed[node] = std::abs(velocity);
   }
   const bool any_slipping = std::find(slipping.begin(), slipping.end(), 1) != slipping.end();
   if (!in_event_) {
@@ -114,10 +117,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   }
   for (std::size_t node = 0; node < n; ++node) {
     if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Detached)) in_contact_.touch(node);
-    if (frame.state[node] == static_cast<std::uint8_t>(ContactState::Sliding) && node < frame.slip_velocity.size()) {
-      current_.peak_slip_velocity[node] =
-          std::max(current_.peak_slip_velocity[node], std::abs(frame.slip_velocity[node]));
-    }
+    current_.peak_slip_velocity[node] = std::max(current_.peak_slip_velocity[node], sliding_speed[node]);
     if (slipping[node] && std::isnan(current_.first_unstick_time[node])) {
       current_.first_unstick_time[node] = frame.time;
     }

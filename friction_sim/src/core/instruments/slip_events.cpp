@@ -33,7 +33,6 @@ SlipEventDetector::SlipEventDetector(const Model& model, int front_fit_nodes, do
   began_at_.resize(positions_.size());
   quiet_u_.resize(positions_.size());
   slip_speed_.assign(positions_.size(), 0.0);
-  slipping_.assign(positions_.size(), 0);
 }
 
 void SlipEventDetector::watchSlip(double step_start, double dt, const ContactInterface& contact, const Vector& v) {
@@ -64,14 +63,15 @@ void SlipEventDetector::watchSlip(double step_start, double dt, const ContactInt
     const double velocity = v[dofs_[node]];
     const double speed = state == ContactState::Sliding ? std::abs(velocity) : 0.0;
     const bool slipping = criterion_.slipping(state, velocity);
-    if (slipping && !slipping_[node]) {
+    // A node not sliding has speed 0, below the criterion's: its speed alone says whether it slipped.
+    const bool was_slipping = slip_speed_[node] >= criterion_.speed;
+    if (slipping && !was_slipping) {
       began_.push_back(static_cast<int>(node));
       began_at_[node] = crossing(slip_speed_[node], speed);
-    } else if (!slipping && slipping_[node]) {
+    } else if (!slipping && was_slipping) {
       note_ceased(crossing(slip_speed_[node], speed));
     }
     slip_speed_[node] = speed;
-    slipping_[node] = slipping;
     slipping_count_ += slipping;
   }
 }
