@@ -8,7 +8,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${1:-$root/.build/core-sanitize}"
 # Only the system's tools: no /opt/ros, no pyenv.
 export PATH=/usr/bin:/bin
-# Under the sanitizers the cases run about ten times slower than in Release. The twenty-two longest
+# Under the sanitizers the cases run about ten times slower than in Release. The twenty-four longest
 # (4.5 to 38 s each, most of the sanitized run) repeat at larger sizes or over longer runs what others
 # test; the Release build runs them all.
 slow=(
@@ -35,6 +35,7 @@ slow=(
   RateStateBlock.SteadySlidingFollowsTheSteadyStateCurveOverSixDecadesOfSpeed
   RateStateBlock.VelocityStepJumpsByTheDirectEffectThenEvolvesOverTheCharacteristicSlip
   FrameEventDetector.RateStateEventsEndOnTheirSlipSpeedWhileTheInterfaceCreeps
+  QuasiStaticCreep.CreepingSliderHasTheFullDynamicsPrecursors
 )
 filter="-$(IFS=:; echo "${slow[*]}")"
 # -O1 with line tables: a quick build, and reports that name the line.

@@ -20,6 +20,7 @@ add_library(friction_sim_core
   src/core/model/model.cpp
   src/core/run/command_schedule.cpp
   src/core/run/fast_forward.cpp
+  src/core/run/quasi_static_creep.cpp
   src/core/run/run_driver.cpp
   src/core/run/simulation.cpp
   src/core/run/simulation_commands.cpp

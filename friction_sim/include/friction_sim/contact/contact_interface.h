@@ -74,6 +74,16 @@ class ContactInterface {
   /// re-applied).
   bool updateStates(Vector& u, Vector& v, double dt, double node_mass);
 
+  // Quasi-static creep (QuasiStaticCreep): a node slides so slowly that its friction balances its load, and
+  // the slider moves through equilibria rather than by steps.
+  /// The sliding `node` slid `slip` (m) while its friction went from its value now to `end_friction` (N):
+  /// the law learns of the slip, and its work (by the trapezoid) is dissipated.
+  void creep(int node, double slip, double end_friction);
+  /// The creeping `node` stops where it is, at the end of the last advance.
+  void stopCreeping(int node, const Vector& u);
+  /// ±1, the direction in which the sliding `node` moves.
+  int slidingDirection(int node) const { return static_cast<int>(friction_mode_[node]); }
+
   int size() const { return static_cast<int>(state_.size()); }
   /// The first interface degree of freedom; the others follow it contiguously.
   int firstDof() const { return first_dof_; }
@@ -86,7 +96,8 @@ class ContactInterface {
   long long contactChanges() const { return contact_changes_; }
   /// Whether an equilibrium found with the stuck nodes pinned keeps them stuck, each in contact and its
   /// pin's reaction, −trial.force at its dof, within µ_s·N, and keeps every detached node off the track.
-  bool holdsPinned(const ForceEvaluation& trial) const;
+  /// With `sliding_pinned`, sliding nodes were pinned too, and need only stay in contact (they creep).
+  bool holdsPinned(const ForceEvaluation& trial, bool sliding_pinned = false) const;
   double frictionForce(int node) const { return friction_[latest_slot_][node]; }  ///< N, track on slider, x
   double normalForce(int node) const { return latest_normal_[node]; }             ///< N
   double slip(int node, const Vector& u) const { return u[dofs_[node]] - slip_origin_[node]; }  ///< m

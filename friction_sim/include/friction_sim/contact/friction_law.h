@@ -48,6 +48,11 @@ class FrictionLaw {
   }
   /// µ_s of `node` if it stays stuck for `elapsed` (s) more.
   virtual double staticCoefficientAfter(int node, double /*elapsed*/) const { return staticCoefficient(node); }
+  /// µ of the sliding `node` at `speed` (m/s, ≥ 0) after it slid |`slip`| (m) more over `elapsed` (s), its
+  /// state evolved over that slide as onSlip would evolve it.
+  virtual double coefficientAfterSlip(int node, double speed, double /*slip*/, double /*elapsed*/) const {
+    return coefficientAt(node, speed);
+  }
   /// `node` touched the track again after a loss of contact: a new contact.
   virtual void onLanding(int /*node*/) {}
   /// The per-node state as numbers, for the run's state hash (empty: none).
@@ -105,6 +110,9 @@ class RateAndState : public FrictionLaw {
   double endSpeed(int node, double reach, double resistance) const override;
   double staticCoefficientAfter(int node, double elapsed) const override {
     return spec_.staticCoefficient(age(node) + elapsed);
+  }
+  double coefficientAfterSlip(int node, double speed, double slip, double elapsed) const override {
+    return spec_.coefficient(speed, spec_.ageAfterSlip(age(node), slip, elapsed));
   }
   void onLanding(int node) override;
   std::vector<double> stateNumbers() const override;

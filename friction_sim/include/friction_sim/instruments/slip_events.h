@@ -104,6 +104,7 @@ class SlipEventDetector {
   /// `slider_length` (m): L, the single block's L_p when it slips (measureExtent).
   SlipEventDetector(const Model& model, int front_fit_nodes, double longitudinal_speed, double slider_length,
                     SlipCriterion criterion = {});
+  const SlipCriterion& criterion() const { return criterion_; }
 
   /// The load cells over the step just taken: F_X at its start and end, F_Z.
   struct StepLoads {

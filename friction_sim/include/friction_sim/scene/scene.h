@@ -78,6 +78,14 @@ struct RateStateSpec {
   double speedSlope(double speed) const { return direct_effect / (reference_speed + speed); }
   /// µ of steady sliding at `speed` (m/s, > 0): φ = D/speed.
   double steadyStateCoefficient(double speed) const { return coefficient(speed, characteristic_slip / speed); }
+  /// s, the age of a contact `age` (s) old after it slid `slip` (m) at a constant speed over `elapsed` (s):
+  /// the ageing law dφ/dt = 1 − vφ/D solved exactly, φ relaxing towards D/v as exp(−|slip|/D).
+  double ageAfterSlip(double age, double slip, double elapsed) const {
+    const double renewed = std::abs(slip) / characteristic_slip;
+    // elapsed·(1 − e^(−x))/x, which is elapsed as x → 0.
+    const double grown = renewed > 0.0 ? elapsed * -std::expm1(-renewed) / renewed : elapsed;
+    return age * std::exp(-renewed) + grown;
+  }
 };
 
 struct FrictionSpec {

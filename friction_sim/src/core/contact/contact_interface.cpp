@@ -397,16 +397,30 @@ void ContactInterface::unstick(int node, Vector& u, Vector& v, double dt, double
   addSlip(node, catch_up);
 }
 
-bool ContactInterface::holdsPinned(const ForceEvaluation& trial) const {
+bool ContactInterface::holdsPinned(const ForceEvaluation& trial, bool sliding_pinned) const {
   for (int node = 0; node < size(); ++node) {
     const double normal = trial.normal_force[node];
     if (state_[node] == ContactState::Detached) {
       if (normal > 0.0) return false;
-    } else if (normal <= 0.0 || std::abs(trial.force[dofs_[node]]) > law_->staticCoefficient(node) * normal) {
+    } else if (normal <= 0.0) {
+      return false;
+    } else if (!(sliding_pinned && state_[node] == ContactState::Sliding) &&
+               std::abs(trial.force[dofs_[node]]) > law_->staticCoefficient(node) * normal) {
       return false;
     }
   }
   return true;
+}
+
+void ContactInterface::creep(int node, double slip, double end_friction) {
+  dissipation_ -= 0.5 * (friction_[latest_slot_][node] + end_friction) * slip;
+  addSlip(node, slip);
+}
+
+void ContactInterface::stopCreeping(int node, const Vector& u) {
+  stick(node, u);
+  transition_fraction_[node] = 1.0;
+  restuck_last_step_.push_back(node);
 }
 
 double ContactInterface::anchorEnergy(const Vector& u) const {

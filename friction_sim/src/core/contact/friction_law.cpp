@@ -30,13 +30,7 @@ void RateAndState::settle(int node) {
 }
 
 void RateAndState::onSlip(int node, double slip) {
-  // dφ/dt = 1 − vφ/D at the constant speed v = s/Δt: φ relaxes towards D/v as exp(−s/D).
-  const double elapsed = now_ - since_[node];
-  const double renewed = std::abs(slip) / spec_.characteristic_slip;
-  const double kept = std::exp(-renewed);
-  // Δt·(1 − e^(−x))/x, which is Δt as x → 0.
-  const double grown = renewed > 0.0 ? elapsed * -std::expm1(-renewed) / renewed : elapsed;
-  age_[node] = age_[node] * kept + grown;
+  age_[node] = spec_.ageAfterSlip(age_[node], slip, now_ - since_[node]);
   since_[node] = now_;
 }
 

@@ -9,13 +9,16 @@
 
 namespace friction {
 
-FastForward::FastForward(Simulation& simulation) : sim_(simulation) {}
+FastForward::FastForward(Simulation& simulation) : sim_(simulation), creep_(simulation) {}
 
 bool FastForward::approachingThreshold() const {
   return approaching_threshold_ && sim_.stage_.velocity() == approach_velocity_;
 }
 
-bool FastForward::mayJump() const { return quasi_static_ && !approachingThreshold() && !sim_.stageTooFast(); }
+bool FastForward::mayJump() const {
+  // Where nodes may creep, a threshold's approach ends in a creep step rather than in the dynamics.
+  return quasi_static_ && (!approachingThreshold() || creep_.enabled()) && !sim_.stageTooFast();
+}
 
 StaticSolver* FastForward::pinnedSolver() {
   const ContactInterface& contact = sim_.contact_;
@@ -25,6 +28,7 @@ StaticSolver* FastForward::pinnedSolver() {
   }
   if (lifted != lifted_nodes_ || (lifted_nodes_.empty() && !pinned_solver_)) {
     pinned_solver_.reset();  // first: at 10⁶ nodes two solvers would not fit the memory budget
+    creep_.forget();
     lifted_nodes_.swap(lifted);
     std::vector<int> in_contact;
     for (int node = 0; node < contact.size(); ++node) {
@@ -42,7 +46,15 @@ StaticSolver* FastForward::pinnedSolver() {
 
 bool FastForward::relaxToStaticEquilibrium() {
   Simulation& s = sim_;
-  if (s.contact_.slidingCount() > 0) return false;
+  const ContactInterface& contact = s.contact_;
+  const bool creeping = contact.slidingCount() > 0;
+  if (creeping) {
+    if (!creep_.enabled()) return false;
+    for (int node = 0; node < contact.size(); ++node) {
+      const bool sliding = contact.state(node) == ContactState::Sliding;
+      if (sliding && std::abs(s.v_[contact.dofs()[node]]) > creep_.exitSpeed()) return false;
+    }
+  }
   StaticSolver* solver = pinnedSolver();
   if (!solver) return false;
   Vector relaxed = s.u_;
@@ -50,7 +62,7 @@ bool FastForward::relaxToStaticEquilibrium() {
   if (solver->solve(*s.model_, relaxed, s.stage_.position()) > StaticSolver::kMaxIterations) return false;
   ForceEvaluation check;
   s.model_->evaluate(relaxed, Vector::Zero(s.u_.size()), s.stage_.position(), check);
-  if (!s.contact_.holdsPinned(check)) return false;
+  if (!s.contact_.holdsPinned(check, creeping)) return false;
   // What the ring-down would have dissipated: the drop in potential energy plus the kinetic energy.
   const double stage = s.stage_.position();
   s.ledger_.addViscous(s.ledger_.potential(*s.model_, s.u_, stage) + s.kineticEnergy() -
@@ -62,7 +74,14 @@ bool FastForward::relaxToStaticEquilibrium() {
   return true;
 }
 
+bool FastForward::creepResumeDue(double time) {
+  if (!creep_.enabled() || quasi_static_ || sim_.detector_.inEvent() || time < next_creep_resume_) return false;
+  next_creep_resume_ = time + sim_.detector_.criterion().quiet_time;
+  return true;
+}
+
 bool FastForward::jump(double until) {
+  if (creep_.enabled() && (sim_.contact_.slidingCount() > 0 || approaching_threshold_)) return creepStep(until);
   // A jump aimed at a threshold uses the equilibrium's slope where it starts; the slope changes along
   // the way (the springs' geometry), so a long jump would land off the crossing by a part in 10⁴ of
   // the load. Approached instead in jumps that each cover a fixed share of what is left, from a slope
@@ -83,23 +102,34 @@ bool FastForward::jump(double until) {
   return jumped;
 }
 
-bool FastForward::jumpAlongEquilibrium(double until, bool& toward_threshold) {
+double FastForward::spanAhead(double until) const {
   const Simulation& s = sim_;
   const StopSpec& stop = s.scene_.stop;
-  const double horizon = std::min({until, stop.time}) - s.time_;
   const double speed = s.stage_.velocity();
-  // The stage's speed holds until its next change, so a travel limit falls at a known time: the jump
+  // The stage's speed holds until its next change, so a travel limit falls at a known time: the advance
   // stops there, as full dynamics stops on the step that reaches it.
   const double to_travel_limit = speed != 0.0 ? (stop.stage_travel - s.stage_.travel()) / std::abs(speed)
                                               : std::numeric_limits<double>::infinity();
-  const double span = std::min({horizon, s.stage_.timeToNextChange(), to_travel_limit});
+  return std::min({until - s.time_, stop.time - s.time_, s.stage_.timeToNextChange(), to_travel_limit});
+}
+
+double FastForward::endTime(double until, double length) const {
+  // An advance to the caller's time ends on it exactly: time + (until − time) can fall an ulp short, and a
+  // command due then would wait a step (the rig compares due times with the clock exactly).
+  const double end = std::min(until, sim_.scene_.stop.time);
+  return length == end - sim_.time_ ? end : sim_.time_ + length;
+}
+
+bool FastForward::jumpAlongEquilibrium(double until, bool& toward_threshold) {
+  const Simulation& s = sim_;
+  const double span = spanAhead(until);
   toward_threshold = false;
   StaticSolver* solver = pinnedSolver();
   if (!(span > s.dt_) || !solver) return false;
   Path path = pathAhead(*solver, span);
   if (!(path.length > s.dt_)) {
     approaching_threshold_ = path.stops_at_threshold;
-    approach_velocity_ = speed;
+    approach_velocity_ = s.stage_.velocity();
     return false;
   }
   // With nothing due, no end and no threshold ahead (a stage at rest) the jump has no end: nothing
@@ -107,11 +137,7 @@ bool FastForward::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   if (!std::isfinite(path.length)) return false;
   if (path.stops_at_threshold) path.length *= kApproachShare;
   toward_threshold = path.stops_at_threshold;
-  // A jump to the caller's time ends on it exactly: time + (until − time) can fall an ulp short, and a
-  // command due then would wait a step (the rig compares due times with the clock exactly).
-  const double end_time =
-      !path.stops_at_threshold && path.length == horizon ? std::min(until, stop.time) : s.time_ + path.length;
-  takeJump(*solver, path, end_time);
+  takeJump(*solver, path, path.stops_at_threshold ? s.time_ + path.length : endTime(until, path.length));
   return true;
 }
 
@@ -224,6 +250,54 @@ void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   const double kinetic_before = s.kineticEnergy();
   solver.solve(*s.model_, s.u_, stage_end);
   s.v_.swap(path.velocity);
+  jumped_time_ += jump;
+  concludeAdvance(kinetic_before, shear_start, stage_start, stage_end, s.time_, 0.0);
+}
+
+bool FastForward::creepStep(double until) {
+  Simulation& s = sim_;
+  const double span = spanAhead(until);
+  StaticSolver* solver = pinnedSolver();
+  CreepStep step;
+  if (!solver || !(span > s.dt_) || !creep_.plan(*solver, span, step)) {
+    leavePath();
+    return false;
+  }
+  const double shear_start = s.evaluation_.shear_force;
+  const double stage_start = s.stage_.position();
+  const double step_start = s.time_;
+  const double stage_end = s.stage_.positionAfter(step.duration);
+  const Vector start = s.u_;
+  s.u_ += step.displacement;
+  s.stage_.advance(step.duration);
+  s.time_ = endTime(until, step.duration);
+  s.contact_.setTime(s.time_);
+  const double kinetic_before = s.kineticEnergy();
+  // The step's linearised motion is within a part in 10⁴ of equilibrium: one correction leaves a part in
+  // 10⁸, and the next step corrects what is left.
+  solver->correct(*s.model_, s.u_, stage_end);
+  // The bulk at its mean velocity over the step, each creeping node at its speed at the end: the next
+  // step, or the dynamics, starts from it.
+  s.v_ = (s.u_ - start) / step.duration;
+  for (std::size_t i = 0; i < step.nodes.size(); ++i) {
+    const int node = step.nodes[i];
+    const int dof = s.contact_.dofs()[node];
+    s.v_[dof] = s.contact_.slidingDirection(node) * step.speed[i];
+    if (step.speed[i] > 0.0) {
+      s.contact_.creep(node, s.u_[dof] - start[dof], step.end_friction[i]);
+    } else {
+      s.contact_.stopCreeping(node, s.u_);
+    }
+  }
+  jumped_time_ += step.duration;
+  concludeAdvance(kinetic_before, shear_start, stage_start, stage_end, step_start, step.duration);
+  if (step.fastest > creep_.exitSpeed()) leavePath();
+  return true;
+}
+
+void FastForward::concludeAdvance(double kinetic_before, double shear_start, double stage_start, double stage_end,
+                                  double step_start, double length) {
+  Simulation& s = sim_;
   // Along the path every node moves with the stage: the stage supplies that kinetic energy, as in the
   // dynamics, where it accelerates the slider (otherwise the next relaxation would count it as
   // dissipated); kinetic energy lost when the stage stops rings down in the dynamics.
@@ -233,17 +307,16 @@ void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   } else {
     s.ledger_.addViscous(-kinetic_change);
   }
-  // The jump is a step of its own for the slip of an event that starts at its end (a lifted node moved).
+  // The advance is a step of its own for the slip of an event that starts at its end (a lifted node moved).
   s.contact_.beginStep(s.u_, s.v_);
   s.refreshAfterStaticChange();
   // Round-off may land a node just past its threshold: then its slip starts here.
   const ForceEvaluation& end = s.evaluation_;
-  s.detector_.update(s.time_, 0.0, s.contact_, s.u_, s.v_, {end.shear_force, end.shear_force, end.normal_load});
+  s.detector_.update(step_start, length, s.contact_, s.u_, s.v_, {shear_start, end.shear_force, end.normal_load});
   s.ledger_.addPusherWork(shear_start, end.shear_force, stage_start, stage_end);
   ++jumps_;
-  // Any approach before this jump is over: the crossing, if it comes, is found again from here.
+  // Any approach before this advance is over: the crossing, if it comes, is found again from here.
   approaching_threshold_ = false;
-  jumped_time_ += jump;
   s.event_started_ = s.detector_.inEvent();
   s.event_ended_ = false;
   if (s.event_started_) leavePath();

@@ -8,6 +8,7 @@
 
 #include "friction_sim/model/model.h"
 #include "friction_sim/solvers/static_solver.h"
+#include "run/quasi_static_creep.h"
 
 namespace friction {
 
@@ -21,13 +22,19 @@ class FastForward {
   bool quasiStatic() const { return quasi_static_; }
   /// True if the next advance may jump.
   bool mayJump() const;
-  /// The jumps of one advance towards `until` (s); false if a dynamic step is needed instead.
+  /// The jumps of one advance towards `until` (s), or one creep step while nodes creep; false if a
+  /// dynamic step is needed instead.
   bool jump(double until);
-  /// With the interface pinned where it sticks and free where it has lost contact: the static
+  /// With the interface pinned where it sticks or creeps and free where it has lost contact: the static
   /// equilibrium, if it holds every stuck node within its threshold and in contact and every lifted node
-  /// off the track. Applies it (the energy of the ring-down it skips is counted as viscous dissipation)
-  /// and returns true; otherwise leaves the state as it is.
+  /// off the track, and keeps creeping nodes in contact. Applies it (the energy of the ring-down it skips
+  /// is counted as viscous dissipation) and returns true; otherwise leaves the state as it is. Nodes that
+  /// slide may creep only if every one is slower than the creep's exit speed (QuasiStaticCreep).
   bool relaxToStaticEquilibrium();
+  /// True, off the static path and outside events, once every interval of the slip criterion's quiet time
+  /// (the next is booked then), if nodes may creep: the dynamics may then have slowed to a creep that
+  /// relaxToStaticEquilibrium can take back to the path.
+  bool creepResumeDue(double time);
   /// At the loaded equilibrium, or where a step may have brought the slider back to the static path.
   void setQuasiStatic(bool quasi_static) { quasi_static_ = quasi_static; }
   /// An event started or the stage moved too fast: off the static path until it is found again.
@@ -66,6 +73,18 @@ class FastForward {
                       double earliest) const;
   /// Moves the slider and the stage along `path` by its length, the clock to `end_time` (s).
   void takeJump(StaticSolver& solver, Path& path, double end_time);
+  /// s, how far an advance towards `until` (s) may go: to `until`, the stop time, the stage's next change
+  /// or its travel limit. `end_time` (s) gives the clock at the end of an advance of a given length.
+  double spanAhead(double until) const;
+  /// s, the clock after an advance of `length` (s) towards `until` (s) (spanAhead).
+  double endTime(double until, double length) const;
+  /// One creep step towards `until` (s); false, leaving the path, if the dynamics must take over.
+  bool creepStep(double until);
+  /// What every advance along the path ends with: the kinetic energy it changed (from `kinetic_before`, J),
+  /// the pusher's work from F_X = `shear_start` (N) with the stage from `stage_start` to `stage_end` (m),
+  /// slip events over [`step_start`, + `length`] (s), the jump count and the stop condition.
+  void concludeAdvance(double kinetic_before, double shear_start, double stage_start, double stage_end,
+                       double step_start, double length);
   /// Share of the way to an estimated threshold crossing that one jump covers.
   static constexpr double kApproachShare = 0.9;
   /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about five).
@@ -76,6 +95,8 @@ class FastForward {
   bool approachingThreshold() const;
 
   Simulation& sim_;
+  QuasiStaticCreep creep_;
+  double next_creep_resume_ = 0.0;               ///< s, creepResumeDue's next time
   std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
   std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
   bool quasi_static_ = false;

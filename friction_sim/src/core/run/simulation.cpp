@@ -135,7 +135,10 @@ void Simulation::concludeStep(const StepStart& start) {
     // after a fast stage move: only the end of an event brings it back then.
     const bool contact_changed =
         start.was_quasi_static && contact_.contactChanges() != start.contact_changes && !detector_.inEvent();
-    if ((event_ended_ || contact_changed) && !start.stage_too_fast && fast_forward_->relaxToStaticEquilibrium()) {
+    // Or, where nodes may creep, once the dynamics has slowed to a creep.
+    const bool creep_resume_due = fast_forward_->creepResumeDue(time_);
+    if ((event_ended_ || contact_changed || creep_resume_due) && !start.stage_too_fast &&
+        fast_forward_->relaxToStaticEquilibrium()) {
       fast_forward_->setQuasiStatic(true);
     }
   }

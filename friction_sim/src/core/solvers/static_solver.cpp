@@ -102,17 +102,22 @@ Vector StaticSolver::response(const Vector& force) const {
   return out;
 }
 
+double StaticSolver::correct(const Model& model, Vector& u, double stage_position, const Vector& body_force) const {
+  if (free_dofs_.empty()) return 0.0;
+  ForceEvaluation evaluation;
+  model.evaluate(u, Vector::Zero(u.size()), stage_position, evaluation);
+  if (body_force.size() > 0) evaluation.force += body_force;
+  const Vector correction = response(evaluation.force);
+  u += correction;
+  return correction.lpNorm<Eigen::Infinity>();
+}
+
 int StaticSolver::solve(Model& model, Vector& u, double stage_position, const Vector& body_force) const {
   if (free_dofs_.empty()) return 0;
-  ForceEvaluation evaluation;
-  const Vector at_rest = Vector::Zero(u.size());
   for (int iteration = 1; iteration <= kMaxIterations; ++iteration) {
-    model.evaluate(u, at_rest, stage_position, evaluation);
-    if (body_force.size() > 0) evaluation.force += body_force;
-    const Vector correction = response(evaluation.force);
-    u += correction;
+    const double correction = correct(model, u, stage_position, body_force);
     const bool load_changed = balance_load_ && model.rebalanceLoad(u);
-    if (!load_changed && correction.lpNorm<Eigen::Infinity>() < tolerance_) return iteration;
+    if (!load_changed && correction < tolerance_) return iteration;
   }
   return kMaxIterations + 1;
 }
