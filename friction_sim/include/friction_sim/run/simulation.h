@@ -40,7 +40,8 @@ class Simulation : public Dynamics {
   /// Advances by one time step or, with fast-forward on while the interface sits in static equilibrium
   /// with no node sliding and the stage moves slowly, jumps along the equilibrium to the earliest of
   /// `until` (s), the stage's next change and just before the next node reaches its threshold, loses
-  /// contact or, lifted, lands (MODEL.md §5). Where the next two steps end before `group_before` (s), may
+  /// contact or, lifted, lands (MODEL.md §5). While nodes creep quasi-statically (a rate-dependent law),
+  /// takes one creep step instead, which counts as a jump. Where the next two steps end before `group_before` (s), may
   /// take several plain steps instead, each ending before `group_before`, for as long as each changes
   /// nothing at the interface (no node slides, none starts to, no slip event is under way): the same
   /// results as single steps, with the state swept once for all of them
@@ -50,7 +51,8 @@ class Simulation : public Dynamics {
   void advance(double until, double group_before = 0.0);
   /// Advances until the scene's stop condition holds.
   void run();
-  /// True while the slider sits in static equilibrium with no node sliding (fast-forward can jump).
+  /// True while the slider sits in static equilibrium with no node sliding, or creeping quasi-statically
+  /// (fast-forward can jump).
   bool quasiStatic() const;
   /// True if the next `advance` may be a fast-forward jump.
   bool mayJump() const;

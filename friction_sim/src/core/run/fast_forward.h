@@ -18,7 +18,7 @@ class FastForward {
  public:
   explicit FastForward(Simulation& simulation);
 
-  /// True while the slider sits in static equilibrium with no node sliding.
+  /// True while the slider sits in static equilibrium with no node sliding, or creeping quasi-statically.
   bool quasiStatic() const { return quasi_static_; }
   /// True if the next advance may jump.
   bool mayJump() const;
