@@ -5,6 +5,7 @@ before anything runs, with a message that says what is wrong, and no results dir
 command table drives the run as the rig's commands do."""
 import csv
 import os
+import pty
 import shutil
 import subprocess
 import tempfile
@@ -106,6 +107,45 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertAlmostEqual(float(first["onset_time_s"]), 0.725, delta=2e-6)  # dt = 1 µs
         self.assertAlmostEqual(float(first["onset_normal_force_N"]), 2500.0, places=9)
         self.assertAlmostEqual(float(first["shear_ratio"]), 0.4, delta=1e-5)
+
+    def test_one_set_takes_several_assignments(self):
+        # F_Z = 2500 N and one global event: the block slips first at t = 0.4 · 2500 / (4e6 · 4e-4) = 0.625 s.
+        done = subprocess.run([self.runner, SCENE, "--out", self.out, "--set", "load.normal_force=2500",
+                               "stop.global_events=1", "--set", "integrator.time_step=5e-7"],
+                              capture_output=True, text=True, timeout=60)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(os.path.join(self.out, "events.csv")) as events:
+            rows = list(csv.DictReader(events))
+        self.assertEqual(len(rows), 1)
+        self.assertAlmostEqual(float(rows[0]["onset_time_s"]), 0.625, delta=1e-6)  # dt = 0.5 µs
+        self.assertAlmostEqual(float(rows[0]["onset_normal_force_N"]), 2500.0, places=9)
+
+    def test_a_terminal_sees_progress_and_a_pipe_does_not(self):
+        # About 3 s of wall time: 6 s simulated in steps of 1 µs.
+        args = [self.runner, SCENE, "--out", self.out, "--set", "stop.global_events=0", "stop.time=6"]
+        piped = subprocess.run(args, capture_output=True, text=True, timeout=120)
+        self.assertEqual(piped.returncode, 0, piped.stderr)
+        self.assertNotIn("\x1b", piped.stdout + piped.stderr)
+        self.assertNotIn("steps/s,", piped.stderr)
+        master, terminal = pty.openpty()
+        with subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=terminal) as shown:
+            os.close(terminal)
+            seen = b""
+            while True:
+                try:
+                    chunk = os.read(master, 4096)
+                except OSError:  # the run closed the terminal
+                    break
+                if not chunk:
+                    break
+                seen += chunk
+        os.close(master)
+        self.assertEqual(shown.returncode, 0)
+        lines = seen.decode().split("\r\x1b[K")
+        progress = [line for line in lines if "steps/s" in line]
+        self.assertTrue(progress, seen)
+        self.assertRegex(progress[-1], r"^t = [0-9.e+-]+ s of 6 s, [0-9]+ steps/s, [0-9]+ jumps/s, [0-9]+ events, "
+                                       r"at most [0-9]+ s left$")
 
     def test_a_protocol_runs_as_the_controller_runs_it(self):
         # F_Z ramped to 2500 N over 10 ms with the stage held, a hold to t0 = 0.1 s, then V = 0.4 mm/s:

@@ -1,7 +1,10 @@
 // friction_run: runs a scene offline (no ROS master) to its stop condition and writes the results.
 // `friction_run --help` lists its arguments and the files it writes (help() below).
+#include <unistd.h>
+
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -15,7 +18,7 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: friction_run SCENE.yaml [--out DIR] [--set key=value]... [--commands COMMANDS.csv | --protocol "
+    "usage: friction_run SCENE.yaml [--out DIR] [--set key=value...]... [--commands COMMANDS.csv | --protocol "
     "PROTOCOL.yaml]";
 
 /// Exit statuses: a command line that cannot be read, a scene, command table or protocol refused (ConfigError),
@@ -38,11 +41,12 @@ int help() {
   std::cout << kUsage
             << "\n\nRuns a scene offline to its stop condition and writes events.csv, event_nodes.csv, loading.csv,\n"
                "stresses.csv, scene.yaml and summary.txt in DIR (default results/<scene name>).\n"
-               "  --set key=value  overrides one scene field (SI units), validated like the file\n"
+               "  --set key=value...  overrides scene fields (SI units), validated like the file\n"
                "  --commands FILE  drives the stage and F_Z by a command table (rig_report's stage_commands.csv)\n"
                "  --protocol FILE  runs a stage controller's loading protocol from t = 0; its end ends the run\n"
                "Exit status: 0 the run ended, 2 a bad command line, 3 a refused scene, command table or protocol,\n"
-               "4 DIR cannot be written. Reference: docs/offline_runner.md\n";
+               "4 DIR cannot be written. On a terminal, a progress line on standard error.\n"
+               "Reference: docs/offline_runner.md\n";
   return 0;
 }
 
@@ -67,12 +71,15 @@ std::optional<int> parseArguments(int argc, char** argv, Arguments& args) {
     if (paths.count(arg) > 0) {
       *paths.at(arg) = argv[++i];
     } else if (arg == "--set") {
-      const std::string assignment = argv[++i];
-      const auto equals = assignment.find('=');
-      if (equals == std::string::npos || equals == 0 || equals + 1 == assignment.size()) {
-        return refuseCommandLine("--set needs key=value, got '" + assignment + "'");
-      }
-      args.overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
+      // Every argument up to the next option is an assignment.
+      do {
+        const std::string assignment = argv[++i];
+        const auto equals = assignment.find('=');
+        if (equals == std::string::npos || equals == 0 || equals + 1 == assignment.size()) {
+          return refuseCommandLine("--set needs key=value, got '" + assignment + "'");
+        }
+        args.overrides.emplace_back(assignment.substr(0, equals), assignment.substr(equals + 1));
+      } while (i + 1 < argc && argv[i + 1][0] != '-');
     } else {
       return refuseCommandLine("unknown argument '" + arg + "'");
     }
@@ -94,6 +101,37 @@ std::size_t scheduleCommands(const Arguments& args, const friction::LoadingProto
   }
   return scheduled;
 }
+
+/// On a terminal, a line on standard error that the run rewrites twice a second: simulated time against
+/// the stop time, steps and jumps per second of wall time, events so far, and the wall time left were
+/// the run to go on at its mean pace to its time limit (it ends sooner if its events stop it).
+class ProgressLine : public friction::RunStream {
+ public:
+  using Clock = std::chrono::steady_clock;
+  void after(const friction::Simulation& simulation, bool /*jumped*/) override {
+    // Cleared before an event's line goes to standard output (this stream comes before that one).
+    if (simulation.eventEndedLastStep()) clear();
+    const Clock::time_point now = Clock::now();
+    if (now - last_ < std::chrono::milliseconds(500)) return;
+    last_ = now;
+    const double wall = std::chrono::duration<double>(now - start_).count();
+    const double time = simulation.time(), limit = simulation.scene().stop.time;
+    std::fprintf(stderr, "\r\033[Kt = %.4g s of %.4g s, %.0f steps/s, %.0f jumps/s, %zu events", time, limit,
+                 simulation.steps() / wall, simulation.jumps() / wall, simulation.events().size());
+    if (std::isfinite(limit) && time > 0.0) std::fprintf(stderr, ", at most %.0f s left", (limit - time) * wall / time);
+    std::fflush(stderr);
+    shown_ = true;
+  }
+  /// Erases the line, if shown.
+  void clear() {
+    if (shown_) std::fputs("\r\033[K", stderr);
+    shown_ = false;
+  }
+
+ private:
+  Clock::time_point start_ = Clock::now(), last_ = start_;
+  bool shown_ = false;
+};
 
 /// The loading curve into `loading`, stresses.csv into `stresses_csv`, and each event printed as it ends.
 void addStreams(friction::RunDriver& driver, std::vector<friction::LoadCellReading>& loading,
@@ -145,8 +183,10 @@ int run(int argc, char** argv) {
     }
   });
   std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
+  ProgressLine* progress = isatty(fileno(stderr)) ? &driver.add(std::make_unique<ProgressLine>()) : nullptr;
   addStreams(driver, loading, stresses_csv);
   driver.run();
+  if (progress) progress->clear();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string& commands_source = args.commands_path.empty() ? args.protocol_path : args.commands_path;
   if (!commands_source.empty()) {
