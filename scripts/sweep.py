@@ -118,6 +118,11 @@ def precursors(events):
     return out
 
 
+def extended_precursors(events):
+    """A run's precursors with an extent, L_p > 0 (single-node slips left out)."""
+    return [event for event in precursors(events) if float(event["rupture_length_m"]) > 0]
+
+
 def first_global(events):
     """The first global slip event of one run's table, or None."""
     return next((event for event in events if event["global"] == "1"), None)
