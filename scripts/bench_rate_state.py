@@ -18,7 +18,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from perf_report import cpu_model  # noqa: E402
-from sweep import ROOT, RUNNER, first_global, precursors  # noqa: E402
+from sweep import ROOT, RUNNER, extended_precursors, first_global, precursors  # noqa: E402
 
 SCENES = os.path.join(ROOT, "friction_sim/scenes")
 PROTOCOLS = os.path.join(ROOT, "friction_sim/protocols")
@@ -81,16 +81,18 @@ def main():
             label, r["wall"], r["wall"] / base, r["steps"], r["events"], len(r["precursors"]), macro, r["peak"],
             r["residual"]))
     ff = best["pmma_2d_rate_state, fast-forward"]
-    def extended(run):
-        return [float(e["shear_ratio"]) for e in run["precursors"] if float(e["rupture_length_m"]) > 0]
+    def onsets(run):
+        return [float(e["shear_ratio"]) for e in extended_precursors(run["precursors"])]
 
-    onsets = list(zip(extended(ff), extended(full)))
+    # Matched by onset, not by rank: full dynamics at this step adds single-node events early in the
+    # loading (they go when the step is halved), which would shift a pairing by rank.
+    distances = [min(abs(a - b) for b in onsets(full)) for a in onsets(ff)] if onsets(full) else []
     lines += ["", "The 2D runs go to their first global event. Fast-forward against full dynamics with rate_state: "
-              "µ_s,macro %.1e apart; %d and %d precursors with L_p > 0, the onsets of the first %d at most %.1e "
-              "apart in F_X/F_Z (single-node slips and back-slips, which differ more, left out)." % (
+              "µ_s,macro %.1e apart; %d and %d precursors with L_p > 0; each of fast-forward's has one of full "
+              "dynamics' within %.1e in onset F_X/F_Z (median %.1e)." % (
                   abs(float(ff["global"]["peak_shear_ratio"]) - float(full["global"]["peak_shear_ratio"])),
-                  len(extended(ff)), len(extended(full)), len(onsets),
-                  max((abs(a - b) for a, b in onsets), default=0.0))]
+                  len(onsets(ff)), len(onsets(full)), max(distances, default=0.0),
+                  sorted(distances)[len(distances) // 2] if distances else 0.0)]
     path = os.path.join(ROOT, "docs/benchmarks/rate_state.md")
     os.makedirs(os.path.dirname(path), exist_ok=True)
     with open(path, "w") as handle:
