@@ -207,12 +207,15 @@ TEST(SimulatorOptions, EveryBadParameterIsNamedWithValueAndRange) {
   options.real_time_factor = -1.0;
   options.load_cell_rate = 0.0;
   options.overrides = "pusher.height=0.01 broken";
+  options.bag_compression = "zip";
   const auto problems = validateOptions(options);
-  ASSERT_EQ(problems.size(), 4u);
+  ASSERT_EQ(problems.size(), 5u);
   EXPECT_NE(problems[0].find("~scene"), std::string::npos);
   EXPECT_NE(problems[1].find("~real_time_factor: value -1"), std::string::npos);
   EXPECT_NE(problems[2].find("~load_cell_rate: value 0"), std::string::npos);
-  EXPECT_NE(problems[3].find("~overrides: item 'broken'"), std::string::npos);
+  EXPECT_NE(problems[3].find("~bag_compression: value 'zip' is not allowed; allowed: lz4, bz2, none"),
+            std::string::npos);
+  EXPECT_NE(problems[4].find("~overrides: item 'broken'"), std::string::npos);
   std::vector<std::string> ignored;
   const auto overrides = parseOverrides("pusher.height=0.01  stop.global_events=3", ignored);
   ASSERT_EQ(overrides.size(), 2u);

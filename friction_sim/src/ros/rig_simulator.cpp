@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "friction_sim/instruments/results_io.h"
@@ -17,6 +18,16 @@
 namespace friction {
 
 std::atomic<bool> g_stop_requested{false};
+
+namespace {
+/// The compression named by ~bag_compression, or none if the name is unknown.
+std::optional<rosbag::compression::CompressionType> bagCompression(const std::string& name) {
+  if (name == "lz4") return rosbag::compression::LZ4;
+  if (name == "bz2") return rosbag::compression::BZ2;
+  if (name == "none") return rosbag::compression::Uncompressed;
+  return std::nullopt;
+}
+}  // namespace
 
 std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   std::vector<std::string> problems;
@@ -33,6 +44,9 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
       {"lattice_rate", o.lattice_rate},         {"snapshot_rate", o.snapshot_rate}};
   for (const auto& [name, rate] : rates) require(std::isfinite(rate) && rate > 0.0, name, rate, "a rate > 0 Hz");
   if (o.frame_id.empty()) problems.push_back("~frame_id: empty; allowed: a frame name such as 'slider'");
+  if (!bagCompression(o.bag_compression)) {
+    problems.push_back("~bag_compression: value '" + o.bag_compression + "' is not allowed; allowed: lz4, bz2, none");
+  }
   parseOverrides(o.overrides, problems);
   return problems;
 }
@@ -51,6 +65,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   pnh.param("lattice_rate", o.lattice_rate, o.lattice_rate);
   pnh.param("snapshot_rate", o.snapshot_rate, o.snapshot_rate);
   pnh.param("bag", o.bag_path, o.bag_path);
+  pnh.param("bag_compression", o.bag_compression, o.bag_compression);
   pnh.param("frame_id", o.frame_id, o.frame_id);
   pnh.param("stop_at_scene_end", o.stop_at_scene_end, o.stop_at_scene_end);
   pnh.param("start_paused", o.start_paused, o.start_paused);
@@ -77,6 +92,7 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
   if (!options_.bag_path.empty()) {
     try {
       bag_.open(options_.bag_path, rosbag::bagmode::Write);
+      bag_.setCompression(*bagCompression(options_.bag_compression));
     } catch (const rosbag::BagException& error) {
       throw ConfigError("parameters of " + ros::this_node::getName(),
                         {"~bag: value '" + options_.bag_path + "' cannot be written (" + error.what() +

@@ -13,6 +13,7 @@
 //   lattice_rate (double, 200)      Hz of simulated time, lattice snapshots (also written to the bag)
 //   snapshot_rate (double, 20)      Hz of wall time, extra lattice snapshots while someone watches live
 //   bag (string, "")                write every instrument topic to this bag, independent of subscribers
+//   bag_compression (string, "lz4") the bag's chunks: "lz4", "bz2" or "none" (docs/ros_api.md: sizes)
 //   frame_id (string, "slider")     frame of every message
 //   stop_at_scene_end (bool, true)  end when the scene's stop condition holds
 //   start_paused (bool, false)      wait at t = 0 until `pause` is called with false (a controller
@@ -85,21 +86,22 @@
 namespace friction {
 
 struct SimulatorOptions {
-  std::string scene_path;              ///< path of the scene YAML
-  std::string overrides;               ///< "key=value ..." scene fields to replace
-  double real_time_factor = 0.0;       ///< sim s per wall s; 0 = as fast as possible
-  double load_cell_rate = 1e4;         ///< Hz, simulated
-  double gauge_rate = 1e4;             ///< Hz, simulated
-  double interface_rate = 1e5;         ///< Hz, simulated, during events
-  double interface_idle_rate = 100.0;  ///< Hz, simulated, while all is stuck
-  double stage_state_rate = 1e3;       ///< Hz, simulated
-  double clock_rate = 1e4;             ///< Hz, simulated
-  double lattice_rate = 200.0;         ///< Hz, simulated
-  double snapshot_rate = 20.0;         ///< Hz, wall
-  std::string bag_path;                ///< "" = no bag
-  std::string frame_id = "slider";     ///< frame of every message, the slider's (x along the track, z up)
-  bool stop_at_scene_end = true;       ///< end the run when the scene's stop condition holds
-  bool start_paused = false;           ///< wait at t = 0 until `pause` is called with false
+  std::string scene_path;               ///< path of the scene YAML
+  std::string overrides;                ///< "key=value ..." scene fields to replace
+  double real_time_factor = 0.0;        ///< sim s per wall s; 0 = as fast as possible
+  double load_cell_rate = 1e4;          ///< Hz, simulated
+  double gauge_rate = 1e4;              ///< Hz, simulated
+  double interface_rate = 1e5;          ///< Hz, simulated, during events
+  double interface_idle_rate = 100.0;   ///< Hz, simulated, while all is stuck
+  double stage_state_rate = 1e3;        ///< Hz, simulated
+  double clock_rate = 1e4;              ///< Hz, simulated
+  double lattice_rate = 200.0;          ///< Hz, simulated
+  double snapshot_rate = 20.0;          ///< Hz, wall
+  std::string bag_path;                 ///< "" = no bag
+  std::string bag_compression = "lz4";  ///< "lz4", "bz2" or "none": how the bag's chunks are compressed
+  std::string frame_id = "slider";      ///< frame of every message, the slider's (x along the track, z up)
+  bool stop_at_scene_end = true;        ///< end the run when the scene's stop condition holds
+  bool start_paused = false;            ///< wait at t = 0 until `pause` is called with false
 };
 
 /// Every problem of the options, each naming the parameter, the value and the allowed range.
