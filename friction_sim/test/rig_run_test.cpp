@@ -37,6 +37,8 @@
 #include "friction_sim/instruments/results_io.h"
 #include "friction_sim/ros/conversions.h"
 #include "friction_sim/ros/node_parameters.h"
+#include "friction_sim/ros/precursor_detector.h"
+#include "friction_sim/ros/rig_simulator.h"
 #include "friction_sim/run/run_driver.h"
 #include "friction_sim/run/simulation.h"
 #include "friction_sim/scene/loading_protocol.h"
@@ -337,6 +339,21 @@ TEST(FullRun, TopicsHaveTheirTypesAndSimulatedTimeStamps) {
   expectLoadCellsEvery100Microseconds();
   EXPECT_GT(g_seen.gauge_profiles, 0);
   EXPECT_GT(g_seen.stage_states, 0);
+}
+
+TEST(FullRun, EveryNodeParameterIsOnTheParameterServerDefaultsIncluded) {
+  // None of these is set by the launch files: each node wrote back the default it ran with.
+  double clock_rate = 0.0;
+  std::string compression, frame;
+  int fit_nodes = 0;
+  ASSERT_TRUE(ros::param::get("/rig/simulator/clock_rate", clock_rate));
+  EXPECT_EQ(clock_rate, SimulatorOptions().clock_rate);
+  ASSERT_TRUE(ros::param::get("/rig/simulator/bag_compression", compression));
+  EXPECT_EQ(compression, "lz4");
+  ASSERT_TRUE(ros::param::get("/rig/simulator/frame_id", frame));
+  EXPECT_EQ(frame, "slider");
+  ASSERT_TRUE(ros::param::get("/rig/precursor_detector/front_fit_nodes", fit_nodes));
+  EXPECT_EQ(fit_nodes, DetectorOptions().front_fit_nodes);
 }
 
 TEST(FullRun, StageTravelFollowsThePositionAcrossFastForwardJumps) {

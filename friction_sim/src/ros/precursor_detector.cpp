@@ -20,9 +20,9 @@ std::vector<std::string> validateDetectorOptions(const DetectorOptions& options)
 
 DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh) {
   DetectorOptions options;
-  private_nh.param("front_fit_nodes", options.front_fit_nodes, options.front_fit_nodes);
-  private_nh.param("scene", options.scene_path, options.scene_path);
-  private_nh.param("overrides", options.overrides, options.overrides);
+  readParameter(private_nh, "front_fit_nodes", options.front_fit_nodes);
+  readParameter(private_nh, "scene", options.scene_path);
+  readParameter(private_nh, "overrides", options.overrides);
   refuseParameters(private_nh, validateDetectorOptions(options));
   return options;
 }

@@ -53,22 +53,22 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
 
 SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   SimulatorOptions o;
-  pnh.param("scene", o.scene_path, o.scene_path);
-  pnh.param("overrides", o.overrides, o.overrides);
-  pnh.param("real_time_factor", o.real_time_factor, o.real_time_factor);
-  pnh.param("load_cell_rate", o.load_cell_rate, o.load_cell_rate);
-  pnh.param("gauge_rate", o.gauge_rate, o.gauge_rate);
-  pnh.param("interface_rate", o.interface_rate, o.interface_rate);
-  pnh.param("interface_idle_rate", o.interface_idle_rate, o.interface_idle_rate);
-  pnh.param("stage_state_rate", o.stage_state_rate, o.stage_state_rate);
-  pnh.param("clock_rate", o.clock_rate, o.clock_rate);
-  pnh.param("lattice_rate", o.lattice_rate, o.lattice_rate);
-  pnh.param("snapshot_rate", o.snapshot_rate, o.snapshot_rate);
-  pnh.param("bag", o.bag_path, o.bag_path);
-  pnh.param("bag_compression", o.bag_compression, o.bag_compression);
-  pnh.param("frame_id", o.frame_id, o.frame_id);
-  pnh.param("stop_at_scene_end", o.stop_at_scene_end, o.stop_at_scene_end);
-  pnh.param("start_paused", o.start_paused, o.start_paused);
+  readParameter(pnh, "scene", o.scene_path);
+  readParameter(pnh, "overrides", o.overrides);
+  readParameter(pnh, "real_time_factor", o.real_time_factor);
+  readParameter(pnh, "load_cell_rate", o.load_cell_rate);
+  readParameter(pnh, "gauge_rate", o.gauge_rate);
+  readParameter(pnh, "interface_rate", o.interface_rate);
+  readParameter(pnh, "interface_idle_rate", o.interface_idle_rate);
+  readParameter(pnh, "stage_state_rate", o.stage_state_rate);
+  readParameter(pnh, "clock_rate", o.clock_rate);
+  readParameter(pnh, "lattice_rate", o.lattice_rate);
+  readParameter(pnh, "snapshot_rate", o.snapshot_rate);
+  readParameter(pnh, "bag", o.bag_path);
+  readParameter(pnh, "bag_compression", o.bag_compression);
+  readParameter(pnh, "frame_id", o.frame_id);
+  readParameter(pnh, "stop_at_scene_end", o.stop_at_scene_end);
+  readParameter(pnh, "start_paused", o.start_paused);
   refuseParameters(pnh, validateOptions(o));
   return o;
 }

@@ -25,8 +25,8 @@ std::vector<std::string> validateControllerOptions(const ControllerOptions& opti
 
 ControllerOptions readControllerOptions(const ros::NodeHandle& private_nh) {
   ControllerOptions options;
-  private_nh.param("protocol", options.protocol_path, options.protocol_path);
-  private_nh.param("start_delay", options.start_delay, options.start_delay);
+  readParameter(private_nh, "protocol", options.protocol_path);
+  readParameter(private_nh, "start_delay", options.start_delay);
   refuseParameters(private_nh, validateControllerOptions(options));
   return options;
 }
