@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "friction_sim/instruments/results_io.h"
 #include "friction_sim/run/run_driver.h"
 #include "test_helpers.h"
 
@@ -155,6 +156,36 @@ TEST(RunDriver, CommandsActWhenDueAndTheRunEndsAtTheRunEndSet) {
   EXPECT_NEAR(applied_at[0], 0.1, 1e-12);
   ASSERT_EQ(driver.simulation().events().size(), 1U);
   EXPECT_NEAR(driver.simulation().events()[0].onset_time, 0.1 + kFirstSlip, 2.0 * scene.integrator.time_step);
+}
+
+TEST(RunDriver, AnEventUnderWayWhereTheRunStopsIsReportedUnfinished) {
+  // The block slips from t = 0.48 s for half a period, π·√(m/K) = 0.43 ms; the run stops 0.2 ms in, when
+  // it has slid Δ·(1 − cos ωτ) + V·τ with Δ = (µ_s − µ_k)·F_Z/K and ω = √(K/m) (MODEL.md §7.1).
+  const double into_slip = 2e-4;
+  const Scene scene = blockScene(false, kFirstSlip + into_slip);
+  RunDriver driver(scene, requireValidScene(scene));
+  Counts counts;
+  addEveryStream(driver, counts);
+  driver.run();
+  ASSERT_TRUE(driver.simulation().events().empty());
+  ASSERT_TRUE(driver.simulation().inEvent());
+  driver.finishRun();
+  const Simulation& simulation = driver.simulation();
+  ASSERT_EQ(simulation.events().size(), 1u);
+  EXPECT_EQ(counts.ended, 1);
+  const SlipEvent& event = simulation.events()[0];
+  EXPECT_TRUE(event.unfinished);
+  EXPECT_EQ(event.end_time, simulation.time());
+  const double mass = scene.material.density * scene.geometry.length * scene.geometry.height * scene.geometry.width;
+  const double drop =
+      (scene.friction.static_coefficient - scene.friction.kinetic_coefficient) * 1920.0 / kStageStiffness;
+  const double slipping = simulation.time() - event.onset_time;  // the run ends on a step: up to dt past its stop
+  const double slid = drop * (1.0 - std::cos(std::sqrt(kStageStiffness / mass) * slipping)) + kStageSpeed * slipping;
+  EXPECT_NEAR(event.node_slip[0] / slid, 1.0, 1e-3);
+  EXPECT_TRUE(summarize(simulation, 0.0).last_event_unfinished);
+  // Nothing more to end.
+  driver.finishRun();
+  EXPECT_EQ(simulation.events().size(), 1u);
 }
 
 }  // namespace

@@ -94,6 +94,7 @@ friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>
   msg.rupture_length = event.rupture_length;
   msg.slider_length = slider_length;
   msg.global_event = event.global;
+  msg.unfinished = event.unfinished;
   msg.mean_slip = event.meanSlip();
   msg.position = positions;
   msg.node_slip = event.node_slip;
@@ -123,6 +124,7 @@ SlipEvent fromMsg(const friction_msgs::SlipEvent& msg) {
   event.slip_max_x = msg.slip_max_x;
   event.rupture_length = msg.rupture_length;
   event.global = msg.global_event;
+  event.unfinished = msg.unfinished;
   event.node_slip = msg.node_slip;
   event.first_unstick_time = msg.first_unstick_time;
   event.front_speed = msg.front_speed;

@@ -387,6 +387,7 @@ std::string RigSimulator::runUntilTheEnd() {
 }
 
 void RigSimulator::finish(const std::string& end_reason) {
+  driver_->finishRun();
   publishStageState();
   // The summary is the run since the last reset: its simulated time and steps start there, and its wall
   // time is the time spent running since, not waiting paused (for a controller, or a user).

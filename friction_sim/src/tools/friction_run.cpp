@@ -187,6 +187,7 @@ int run(int argc, char** argv) {
   addStreams(driver, loading, stresses_csv);
   driver.run();
   if (progress) progress->clear();
+  driver.finishRun();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::string& commands_source = args.commands_path.empty() ? args.protocol_path : args.commands_path;
   if (!commands_source.empty()) {

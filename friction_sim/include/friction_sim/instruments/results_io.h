@@ -19,10 +19,11 @@ struct PrecursorPoint {
 };
 
 struct RunSummary {
-  std::string scene_name;   ///< the scene's name
-  std::string stop_reason;  ///< which stop condition ended the run, or why it was cut short
-  int events = 0;           ///< slip events that ended
-  int precursors = 0;       ///< non-global events before the first global one, back-slips not counted
+  std::string scene_name;              ///< the scene's name
+  std::string stop_reason;             ///< which stop condition ended the run, or why it was cut short
+  int events = 0;                      ///< slip events that ended
+  bool last_event_unfinished = false;  ///< the run stopped during its last event (SlipEvent::unfinished)
+  int precursors = 0;                  ///< non-global events before the first global one, back-slips not counted
   int back_slips = 0;  ///< events before the first global one in which the interface slid back (SlipEvent::backSlip)
   int single_node_precursors = 0;  ///< of those, events in which one node alone slipped (L_p = 0): no front ran
   std::vector<PrecursorPoint> precursor_points;

@@ -36,11 +36,13 @@ struct SlipEvent {
   double mean_normal_force = 0.0;  ///< N
   /// mean F_X / mean F_Z (µ_k,macro over a global event)
   double meanShearRatio() const { return mean_shear_force / mean_normal_force; }
-  double nucleation_position = 0.0;        ///< m, mean x of the nodes that unstuck first
-  double slip_min_x = 0.0;                 ///< m, smallest x of a node that slipped
-  double slip_max_x = 0.0;                 ///< m, largest x of a node that slipped
-  double rupture_length = 0.0;             ///< m, L_p = slip_max_x − slip_min_x (L for one node: measureExtent)
-  bool global = false;                     ///< every interface node in contact with the track slipped (measureExtent)
+  double nucleation_position = 0.0;  ///< m, mean x of the nodes that unstuck first
+  double slip_min_x = 0.0;           ///< m, smallest x of a node that slipped
+  double slip_max_x = 0.0;           ///< m, largest x of a node that slipped
+  double rupture_length = 0.0;       ///< m, L_p = slip_max_x − slip_min_x (L for one node: measureExtent)
+  bool global = false;               ///< every interface node in contact with the track slipped (measureExtent)
+  /// The run stopped during the event: it ends where the run ended, its extent and slips as they were then.
+  bool unfinished = false;
   std::vector<double> node_slip;           ///< m, per interface node, displacement during the event
   std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
   std::vector<double> front_speed;         ///< m/s, v_c per node from the first-unstick times; NaN where undefined
@@ -122,6 +124,10 @@ class SlipEventDetector {
   bool update(double step_start, double dt, const ContactInterface& contact, const Vector& u, const Vector& v,
               const StepLoads& loads);
   bool inEvent() const { return in_event_; }
+  /// Ends the event under way, if any, at `time` (s) with F_X = `shear_force` (N) and the displacements `u`,
+  /// flagged unfinished: the run stops during it. One in a quiet spell ends where the spell began, as it
+  /// would have had the spell lasted. Returns true if it ended one (then `events().back()` is it).
+  bool finishUnfinished(double time, double shear_force, const Vector& u);
   /// In the last update a node began slipping, or an event's quiet spell began (SlipCriterion).
   bool slipChangedLastUpdate() const { return !began_.empty() || quiet_began_; }
   const std::vector<SlipEvent>& events() const { return events_; }

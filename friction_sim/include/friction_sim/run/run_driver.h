@@ -206,6 +206,12 @@ class RunDriver {
   void run() {
     while (!finished()) advance();
   }
+  /// Where a caller stops the run: ends a slip event under way, flagged unfinished, and lets every stream
+  /// see it end (the event stream reports it).
+  void finishRun() {
+    if (!simulation_.finishUnfinishedEvent()) return;
+    for (const auto& stream : streams_) stream->after(simulation_, false);
+  }
 
  private:
   /// s, where the next advance must end at the latest.

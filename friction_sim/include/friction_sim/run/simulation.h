@@ -90,6 +90,9 @@ class Simulation : public Dynamics {
   bool interfaceChangedLastStep() const { return event_started_ || event_ended_ || detector_.slipChangedLastUpdate(); }
   /// True while a slip event is under way.
   bool inEvent() const { return detector_.inEvent(); }
+  /// Ends the slip event under way, if any, where the run is now, flagged unfinished: for a caller that
+  /// stops the run here. Returns true if it ended one (eventEndedLastStep() then says so too).
+  bool finishUnfinishedEvent();
   int globalEventCount() const { return detector_.globalEventCount(); }
 
   /// Stage commands from a controller replace the scene's stage program.

@@ -16,6 +16,7 @@ RunSummary summarize(const Simulation& simulation, double wall_time) {
   summary.scene_name = scene.name;
   summary.stop_reason = simulation.stopReason();
   summary.events = static_cast<int>(simulation.events().size());
+  summary.last_event_unfinished = !simulation.events().empty() && simulation.events().back().unfinished;
   summary.static_friction_macro = std::numeric_limits<double>::quiet_NaN();
   summary.kinetic_friction_macro = std::numeric_limits<double>::quiet_NaN();
   for (const SlipEvent& event : simulation.events()) {
@@ -52,6 +53,7 @@ void printSummary(std::ostream& out, const RunSummary& s) {
   if (s.single_node_precursors > 0)
     out << " (single-node slips, L_p = 0, among them: " << s.single_node_precursors << ")";
   if (s.back_slips > 0) out << "; back-slips before it, not counted: " << s.back_slips;
+  if (s.last_event_unfinished) out << "; the last one unfinished (the run stopped during it)";
   out << "\n";
   if (!s.precursor_points.empty()) {
     out << "  precursors (F_X/F_Z, L_p/L):";
@@ -70,7 +72,8 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
   out << "index,onset_time_s,end_time_s,onset_shear_force_N,onset_normal_force_N,shear_ratio,"
          "end_shear_force_N,nucleation_x_m,slip_min_x_m,slip_max_x_m,rupture_length_m,length_ratio,global,"
          "median_front_speed_m_s,front_speed_over_c_s,front_speed_over_c_r,front_fits_left_out,"
-         "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio,peak_shear_force_N,peak_shear_ratio,mean_slip_m\n";
+         "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio,peak_shear_force_N,peak_shear_ratio,mean_slip_m,"
+         "unfinished\n";
   out << std::setprecision(12);
   const double slider_length = scene.geometry.length;
   const WaveSpeeds speeds = waveSpeeds(scene);
@@ -83,7 +86,7 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
         << e.median_front_speed / speeds.shear << ','
         << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out << ','
         << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio() << ',' << e.peak_shear_force
-        << ',' << e.peakShearRatio() << ',' << e.meanSlip() << '\n';
+        << ',' << e.peakShearRatio() << ',' << e.meanSlip() << ',' << (e.unfinished ? 1 : 0) << '\n';
   }
 }
 

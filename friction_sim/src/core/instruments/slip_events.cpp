@@ -168,6 +168,20 @@ void SlipEventDetector::notePeak(double shear_force) {
   if (std::abs(shear_force) > std::abs(current_.peak_shear_force)) current_.peak_shear_force = shear_force;
 }
 
+bool SlipEventDetector::finishUnfinished(double time, double shear_force, const Vector& u) {
+  if (!in_event_) return false;
+  if (std::isnan(quiet_since_)) {
+    quiet_since_ = time;
+    quiet_shear_force_ = shear_force;
+    quiet_shear_impulse_ = shear_impulse_;
+    quiet_normal_impulse_ = normal_impulse_;
+    for (std::size_t node = 0; node < quiet_u_.size(); ++node) quiet_u_[node] = u[dofs_[node]];
+  }
+  finish();
+  events_.back().unfinished = true;
+  return true;
+}
+
 void SlipEventDetector::finish() {
   in_event_ = false;
   SlipEvent& event = current_;

@@ -155,6 +155,13 @@ void Simulation::step() {
   concludeStep(start);
 }
 
+bool Simulation::finishUnfinishedEvent() {
+  if (!detector_.finishUnfinished(time_, evaluation_.shear_force, u_)) return false;
+  event_started_ = false;
+  event_ended_ = true;
+  return true;
+}
+
 void Simulation::run() {
   while (!finished()) advance(scene_.stop.time);
 }
