@@ -188,5 +188,29 @@ TEST(RunDriver, AnEventUnderWayWhereTheRunStopsIsReportedUnfinished) {
   EXPECT_EQ(simulation.events().size(), 1u);
 }
 
+TEST(RunDriver, CommandsStampedPastAKnownRunEndAreRefused) {
+  const Scene scene = blockScene(false, 1.0);
+  const double limit = requireValidScene(scene);
+  TimedCommand late;
+  late.time = 2.0;
+  late.stage = {StageMode::Hold, 0.0, 0.0};
+  TimedCommand due = late;
+  due.time = 0.5;
+  RunDriver ending(scene, limit);
+  EXPECT_EQ(ending.checkCommandTime(late),
+            "stamped at t = 2 s, after the run's end at t = 1 s: it would never be applied");
+  EXPECT_EQ(ending.checkCommandTime(due), "");
+  // Where the scene's end does not end the run (a controller drives it), any time may come, until a
+  // run end is set.
+  RunOptions open_ended;
+  open_ended.stop_at_scene_end = false;
+  RunDriver controlled(scene, limit, open_ended);
+  EXPECT_EQ(controlled.checkCommandTime(late), "");
+  ASSERT_EQ(controlled.setRunEnd(StopSpec{0, 3.0, kInf}), "");
+  EXPECT_EQ(controlled.checkCommandTime(late), "");
+  late.time = 4.0;
+  EXPECT_NE(controlled.checkCommandTime(late).find("after the run's end at t = 3 s"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace friction::testing

@@ -246,6 +246,7 @@ void RigSimulator::publishLiveSnapshot() {
 
 std::string RigSimulator::accept(const friction_msgs::StageCommand& msg) {
   std::string reason = checkCommand(msg, simulation());
+  if (reason.empty()) reason = driver_->checkCommandTime(fromMsg(msg));
   if (!reason.empty()) {
     ROS_WARN_STREAM("stage command refused: " << reason);
     return reason;

@@ -184,8 +184,11 @@ class RunDriver {
   /// Called for every command when it comes due: applied (refusal empty) or refused by the simulation.
   void onCommandDue(CommandSchedule::Report report) { command_due_ = std::move(report); }
 
-  /// Schedules a command at its time (check it first with Simulation::checkCommand): what the simulation
-  /// refuses it for when it is due is reported then.
+  /// Why `command` would never be applied (empty if it may be): stamped past a known end of the run, the
+  /// scene's time limit where it ends the run, or the one set by setRunEnd.
+  std::string checkCommandTime(const TimedCommand& command) const;
+  /// Schedules a command at its time (check it first with Simulation::checkCommand and checkCommandTime):
+  /// what the simulation refuses it for when it is due is reported then.
   void schedule(const TimedCommand& command) { schedule_.add(command); }
   /// Schedules every command of a command table (rig_report's stage_commands.csv) read from `path`, each
   /// checked against the simulation first: throws ConfigError listing every problem. Returns how many.

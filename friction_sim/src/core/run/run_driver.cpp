@@ -1,6 +1,7 @@
 #include "friction_sim/run/run_driver.h"
 
 #include <algorithm>
+#include <sstream>
 
 namespace friction {
 
@@ -42,8 +43,22 @@ std::size_t RunDriver::scheduleAll(const std::vector<TimedCommand>& commands) {
   return commands.size();
 }
 
+std::string RunDriver::checkCommandTime(const TimedCommand& command) const {
+  const double end = simulation_.scene().stop.time;
+  if ((options_.stop_at_scene_end || run_end_set_) && command.time > end) {
+    std::ostringstream reason;
+    reason << "stamped at t = " << command.time << " s, after the run's end at t = " << end
+           << " s: it would never be applied";
+    return reason.str();
+  }
+  return {};
+}
+
 CommandCheck RunDriver::commandCheck() const {
-  return [this](const TimedCommand& command) { return simulation_.checkCommand(command); };
+  return [this](const TimedCommand& command) {
+    std::string refusal = simulation_.checkCommand(command);
+    return refusal.empty() ? checkCommandTime(command) : refusal;
+  };
 }
 
 std::size_t RunDriver::scheduleCommandTable(const std::string& path) {
