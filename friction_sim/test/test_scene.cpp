@@ -171,7 +171,10 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"stop: {time: 0}", "stop.time: value 0", "a time > 0 s (.inf allowed)"},
         // µ_s·F_Z/3 = 256 N per block: the first would slide at t = 0.
         InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [400.0, 0.0, 0.0]}",
-                    "chain.initial_shear[0]: value 400", "|f| <= mu_s * w_0 = 256 N, the block's static threshold"}));
+                    "chain.initial_shear[0]: value 400", "|f| < mu_s * w_0 = 256 N, below the block's static"},
+        // At the threshold itself round-off started block 0 sliding at t = 0, unrecorded.
+        InvalidCase{"model: chain_1d\nchain: {blocks: 3, initial_shear: [256.0, 0.0, 0.0]}",
+                    "chain.initial_shear[0]: value 256", "|f| < mu_s * w_0 = 256 N, below the block's static"}));
 
 TEST(SceneFiles, AShearProfileWithinTheStaticThresholdsIsHeldAsGiven) {
   const Scene scene = parseScene(

@@ -221,8 +221,9 @@ void checkChainStatics(Checker& check, const Scene& s) {
       reported = true;
     }
   }
-  // A prescribed shear is held by rigid sticking only up to each block's static threshold; beyond it
-  // the block would slide at t = 0, before any event could be detected. The pusher holds the sum.
+  // A prescribed shear is held by rigid sticking only below each block's static threshold; at or beyond
+  // it the block would slide at t = 0 (at it, from round-off), before any event could be detected. The
+  // pusher holds the sum.
   const std::vector<double>& shear_profile = s.chain.initial_shear;
   if (!shear_profile.empty()) {
     double held_by_pusher = 0.0;
@@ -230,10 +231,10 @@ void checkChainStatics(Checker& check, const Scene& s) {
     const std::vector<double> w = chain.normalForces(held_by_pusher);
     for (std::size_t i = 0; i < shear_profile.size(); ++i) {
       const double threshold = s.friction.initialStaticCoefficient() * std::max(w[i], 0.0);
-      if (std::abs(shear_profile[i]) <= threshold) continue;
+      if (std::abs(shear_profile[i]) < threshold) continue;
       std::ostringstream allowed;
-      allowed << "|f| <= mu_s * w_" << i << " = " << threshold << " N, the block's static threshold with the pusher "
-              << "holding F_X = " << held_by_pusher << " N";
+      allowed << "|f| < mu_s * w_" << i << " = " << threshold << " N, below the block's static threshold with the "
+              << "pusher holding F_X = " << held_by_pusher << " N";
       check.require(false, "chain.initial_shear[" + std::to_string(i) + "]", shear_profile[i], allowed.str());
     }
   }
