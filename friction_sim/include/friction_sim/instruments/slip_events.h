@@ -138,6 +138,9 @@ class SlipEventDetector {
   void startEvent(double step_start, double dt, const ContactInterface& contact, const Vector& u,
                   const StepLoads& loads);
   void finish();
+  /// Records what the event's end will be if the quiet spell beginning now (quiet_since_) lasts: F_X =
+  /// `shear_force` (N), the impulses so far and the displacements `u`.
+  void noteQuietStart(double shear_force, const Vector& u);
   /// Notes which nodes began and ceased slipping in the step, and when (SlipCriterion).
   void watchSlip(double step_start, double dt, const ContactInterface& contact, const Vector& v);
 
@@ -149,9 +152,9 @@ class SlipEventDetector {
   SlipCriterion criterion_;
   // From the first moment of a quiet spell in the current event: what its end will be if it lasts.
   double quiet_since_ = 0.0;  ///< s; NaN while a node slips
-  double quiet_step_end_ =
-      0.0;                    ///< s, the end of the step it began in, from which it is timed (as the camera times it)
-  bool quiet_began_ = false;  ///< in the last update
+  /// s, the end of the step it began in, from which it is timed (as the camera times it)
+  double quiet_step_end_ = 0.0;
+  bool quiet_began_ = false;           ///< in the last update
   double quiet_shear_force_ = 0.0;     ///< N, F_X then
   double quiet_shear_impulse_ = 0.0;   ///< N·s, ∫F_X dt of the event until then
   double quiet_normal_impulse_ = 0.0;  ///< N·s

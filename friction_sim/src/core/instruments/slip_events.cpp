@@ -153,15 +153,19 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
   add_impulse(from, watch_end);
   if (quiet_began) {
     quiet_step_end_ = step_end;
-    quiet_shear_force_ = shear_at(quiet_since_);
-    quiet_shear_impulse_ = shear_impulse_;
-    quiet_normal_impulse_ = normal_impulse_;
-    for (std::size_t node = 0; node < quiet_u_.size(); ++node) quiet_u_[node] = u[dofs_[node]];
+    noteQuietStart(shear_at(quiet_since_), u);
     add_impulse(std::max(from, watch_end), step_end);
   }
   if (std::isnan(quiet_since_) || step_end - quiet_step_end_ < criterion_.quiet_time) return false;
   finish();
   return true;
+}
+
+void SlipEventDetector::noteQuietStart(double shear_force, const Vector& u) {
+  quiet_shear_force_ = shear_force;
+  quiet_shear_impulse_ = shear_impulse_;
+  quiet_normal_impulse_ = normal_impulse_;
+  for (std::size_t node = 0; node < quiet_u_.size(); ++node) quiet_u_[node] = u[dofs_[node]];
 }
 
 void SlipEventDetector::notePeak(double shear_force) {
@@ -172,10 +176,7 @@ bool SlipEventDetector::finishUnfinished(double time, double shear_force, const 
   if (!in_event_) return false;
   if (std::isnan(quiet_since_)) {
     quiet_since_ = time;
-    quiet_shear_force_ = shear_force;
-    quiet_shear_impulse_ = shear_impulse_;
-    quiet_normal_impulse_ = normal_impulse_;
-    for (std::size_t node = 0; node < quiet_u_.size(); ++node) quiet_u_[node] = u[dofs_[node]];
+    noteQuietStart(shear_force, u);
   }
   finish();
   events_.back().unfinished = true;

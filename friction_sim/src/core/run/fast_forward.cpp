@@ -239,19 +239,12 @@ double FastForward::agedCrossing(int node, double sign, double force, double for
 
 void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   Simulation& s = sim_;
-  const double jump = path.length;
-  const double shear_start = s.evaluation_.shear_force;
-  const double stage_start = s.stage_.position();
-  const double stage_end = s.stage_.positionAfter(jump);
-  s.u_ += (stage_end - stage_start) * path.along;
-  s.stage_.advance(jump);
-  s.time_ = end_time;
-  s.contact_.setTime(end_time);
-  const double kinetic_before = s.kineticEnergy();
-  solver.solve(*s.model_, s.u_, stage_end);
+  const AdvanceStart start = beginAdvance(path.length, end_time);
+  s.u_ += (start.stage_end - start.stage_position) * path.along;
+  solver.solve(*s.model_, s.u_, start.stage_end);
   s.v_.swap(path.velocity);
-  jumped_time_ += jump;
-  concludeAdvance(kinetic_before, shear_start, stage_start, stage_end, s.time_, 0.0);
+  jumped_time_ += path.length;
+  concludeAdvance(start, s.time_, 0.0);
 }
 
 bool FastForward::creepStep(double until) {
@@ -263,45 +256,47 @@ bool FastForward::creepStep(double until) {
     leavePath();
     return false;
   }
-  const double shear_start = s.evaluation_.shear_force;
-  const double stage_start = s.stage_.position();
-  const double step_start = s.time_;
-  const double stage_end = s.stage_.positionAfter(step.duration);
-  const Vector start = s.u_;
+  const Vector u_start = s.u_;
+  const AdvanceStart start = beginAdvance(step.duration, endTime(until, step.duration));
   s.u_ += step.displacement;
-  s.stage_.advance(step.duration);
-  s.time_ = endTime(until, step.duration);
-  s.contact_.setTime(s.time_);
-  const double kinetic_before = s.kineticEnergy();
   // The step's linearised motion is within a part in 10⁴ of equilibrium: one correction leaves a part in
   // 10⁸, and the next step corrects what is left.
-  solver->correct(*s.model_, s.u_, stage_end);
+  solver->correct(*s.model_, s.u_, start.stage_end);
   // The bulk at its mean velocity over the step, each creeping node at its speed at the end: the next
   // step, or the dynamics, starts from it.
-  s.v_ = (s.u_ - start) / step.duration;
+  s.v_ = (s.u_ - u_start) / step.duration;
   for (std::size_t i = 0; i < step.nodes.size(); ++i) {
     const int node = step.nodes[i];
     const int dof = s.contact_.dofs()[node];
     s.v_[dof] = s.contact_.slidingDirection(node) * step.speed[i];
     if (step.speed[i] > 0.0) {
-      s.contact_.creep(node, s.u_[dof] - start[dof], step.end_friction[i]);
+      s.contact_.creep(node, s.u_[dof] - u_start[dof], step.end_friction[i]);
     } else {
       s.contact_.stopCreeping(node, s.u_);
     }
   }
   jumped_time_ += step.duration;
-  concludeAdvance(kinetic_before, shear_start, stage_start, stage_end, step_start, step.duration);
+  concludeAdvance(start, start.time, step.duration);
   if (step.fastest > creep_.exitSpeed()) leavePath();
   return true;
 }
 
-void FastForward::concludeAdvance(double kinetic_before, double shear_start, double stage_start, double stage_end,
-                                  double step_start, double length) {
+FastForward::AdvanceStart FastForward::beginAdvance(double length, double end_time) {
+  Simulation& s = sim_;
+  const AdvanceStart start{s.evaluation_.shear_force, s.stage_.position(), s.stage_.positionAfter(length), s.time_,
+                           s.kineticEnergy()};
+  s.stage_.advance(length);
+  s.time_ = end_time;
+  s.contact_.setTime(end_time);
+  return start;
+}
+
+void FastForward::concludeAdvance(const AdvanceStart& start, double event_start, double event_length) {
   Simulation& s = sim_;
   // Along the path every node moves with the stage: the stage supplies that kinetic energy, as in the
   // dynamics, where it accelerates the slider (otherwise the next relaxation would count it as
   // dissipated); kinetic energy lost when the stage stops rings down in the dynamics.
-  const double kinetic_change = s.kineticEnergy() - kinetic_before;
+  const double kinetic_change = s.kineticEnergy() - start.kinetic_energy;
   if (kinetic_change > 0.0) {
     s.ledger_.addPusherWork(kinetic_change);
   } else {
@@ -312,8 +307,9 @@ void FastForward::concludeAdvance(double kinetic_before, double shear_start, dou
   s.refreshAfterStaticChange();
   // Round-off may land a node just past its threshold: then its slip starts here.
   const ForceEvaluation& end = s.evaluation_;
-  s.detector_.update(step_start, length, s.contact_, s.u_, s.v_, {shear_start, end.shear_force, end.normal_load});
-  s.ledger_.addPusherWork(shear_start, end.shear_force, stage_start, stage_end);
+  s.detector_.update(event_start, event_length, s.contact_, s.u_, s.v_,
+                     {start.shear_force, end.shear_force, end.normal_load});
+  s.ledger_.addPusherWork(start.shear_force, end.shear_force, start.stage_position, start.stage_end);
   ++jumps_;
   // Any approach before this advance is over: the crossing, if it comes, is found again from here.
   approaching_threshold_ = false;

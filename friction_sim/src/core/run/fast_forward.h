@@ -74,17 +74,26 @@ class FastForward {
   /// Moves the slider and the stage along `path` by its length, the clock to `end_time` (s).
   void takeJump(StaticSolver& solver, Path& path, double end_time);
   /// s, how far an advance towards `until` (s) may go: to `until`, the stop time, the stage's next change
-  /// or its travel limit. `end_time` (s) gives the clock at the end of an advance of a given length.
+  /// or its travel limit.
   double spanAhead(double until) const;
   /// s, the clock after an advance of `length` (s) towards `until` (s) (spanAhead).
   double endTime(double until, double length) const;
   /// One creep step towards `until` (s); false, leaving the path, if the dynamics must take over.
   bool creepStep(double until);
-  /// What every advance along the path ends with: the kinetic energy it changed (from `kinetic_before`, J),
-  /// the pusher's work from F_X = `shear_start` (N) with the stage from `stage_start` to `stage_end` (m),
-  /// slip events over [`step_start`, + `length`] (s), the jump count and the stop condition.
-  void concludeAdvance(double kinetic_before, double shear_start, double stage_start, double stage_end,
-                       double step_start, double length);
+  /// Where an advance along the path began, for concludeAdvance.
+  struct AdvanceStart {
+    double shear_force;     ///< N, F_X
+    double stage_position;  ///< m
+    double stage_end;       ///< m, the stage's position where the advance ends
+    double time;            ///< s
+    double kinetic_energy;  ///< J
+  };
+  /// Starts an advance along the path: moves the stage by `length` (s) of its motion and the clock to
+  /// `end_time` (s), and returns where it began. The caller then moves the slider.
+  AdvanceStart beginAdvance(double length, double end_time);
+  /// What every advance along the path ends with: the kinetic energy it changed, the pusher's work, slip
+  /// events over [`event_start`, + `event_length`] (s), the jump count and the stop condition.
+  void concludeAdvance(const AdvanceStart& start, double event_start, double event_length);
   /// Share of the way to an estimated threshold crossing that one jump covers.
   static constexpr double kApproachShare = 0.9;
   /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about five).

@@ -19,7 +19,7 @@ QuasiStaticCreep::QuasiStaticCreep(const Simulation& simulation) : sim_(simulati
   next_duration_ = shortest_;
 }
 
-void QuasiStaticCreep::linearise(const StaticSolver& solver) {
+void QuasiStaticCreep::linearise(const StaticSolver& solver, const ForceEvaluation& here) {
   const Simulation& s = sim_;
   const Model& model = s.model();
   const ContactInterface& contact = s.contact();
@@ -30,8 +30,7 @@ void QuasiStaticCreep::linearise(const StaticSolver& solver) {
   force_.resize(contact.size(), columns);
   normal_.resize(contact.size(), columns);
   const Vector at_rest = Vector::Zero(u.size());
-  ForceEvaluation here, moved;
-  model.evaluate(u, at_rest, stage, here);
+  ForceEvaluation moved;
   const double probe = 1e-6 * model.nodeSpacing();
   for (int column = 0; column < columns; ++column) {
     // A creeping node moved with every other node in contact pinned and the bulk in equilibrium, or the
@@ -154,14 +153,14 @@ bool QuasiStaticCreep::plan(const StaticSolver& solver, double span, CreepStep& 
     nodes.push_back(node);
     directions.push_back(contact.slidingDirection(node));
   }
-  if (&solver != linearised_solver_ || nodes != nodes_ || directions != directions_) {
-    nodes_.swap(nodes);
-    directions_.swap(directions);
-    linearise(solver);
-  }
   const Vector& u = s.displacements();
   ForceEvaluation start;
   s.model().evaluate(u, Vector::Zero(u.size()), s.stage().position(), start);
+  if (&solver != linearised_solver_ || nodes != nodes_ || directions != directions_) {
+    nodes_.swap(nodes);
+    directions_.swap(directions);
+    linearise(solver, start);
+  }
   start_force_.resize(contact.size());
   for (int node = 0; node < contact.size(); ++node) start_force_[node] = start.force[contact.dofs()[node]];
   start_normal_ = start.normal_force;

@@ -56,8 +56,9 @@ class QuasiStaticCreep {
     /// s, the estimated time of the first stuck node's threshold crossing within the step (inf: none)
     double crossing = std::numeric_limits<double>::infinity();
   };
-  /// The creeping nodes' response to their own motion and to the stage's, at the state now.
-  void linearise(const StaticSolver& solver);
+  /// The creeping nodes' response to their own motion and to the stage's, at the state now, whose forces
+  /// (at rest) are `here`.
+  void linearise(const StaticSolver& solver, const ForceEvaluation& here);
   Trial solveAt(double duration) const;
   /// m/s, the speed of log-speed y.
   double speedOf(double log_speed) const { return speed_scale_ * std::expm1(log_speed); }
