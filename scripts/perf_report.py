@@ -314,8 +314,7 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
               "lattices above 4·10⁵ free degrees of freedom use it, smaller ones CHOLMOD's direct factor. Measured by "
               "hand on this machine (2026-11-21): the direct factor has 2.4·10⁸ non-zeros at 10⁶ nodes (2.2 GB, "
               "whatever ordering CHOLMOD uses) and the same run with it peaked at 2957 MB in 144 s; multigrid needs "
-              "11–12 iterations to a 10⁻¹⁰ residual at 57 × 31, 113 × 61 and 225 × 121 alike (tested). The stability "
-              "limit's Lanczos estimates (stiffness and damping) take about 15 s of the wall time (perf)."]
+              "11–12 iterations to a 10⁻¹⁰ residual at 57 × 31, 113 × 61 and 225 × 121 alike (tested)."]
     reference_global = first_global(reference["events"])
     lines += ["", "## Every mode against the reference", "",
               "Scene `pmma_2d` to its first global event. Reference: velocity Verlet, dt = 50 ns, full dynamics "

@@ -43,6 +43,10 @@ class Chain1D : public Model {
   /// Nothing: a block's normal force is prescribed by the loads, not carried by a contact spring.
   void releaseContact(SparseMatrix&, int) const override {}
   SparseMatrix dampingMatrix() const override;
+  Vector anchorStiffness() const override { return driving_stiffness_.matrix(); }
+  /// The free chain's largest, 2k(1 + cos(π/N)) (exact), and 2η(1 + cos(π/N)).
+  double bondStiffnessBound() const override { return k_ * chainLaplacianTop(); }
+  double dampingBound() const override { return eta_ * chainLaplacianTop(); }
   std::vector<int> blockedDofsDuringLoading() const override;
   Vector initialBodyForce() const override;
   void disconnectPusher() override;
@@ -60,6 +64,8 @@ class Chain1D : public Model {
 
  private:
   void updateDrivingStiffness();
+  /// The largest eigenvalue of the free chain's unit-coupling Laplacian.
+  double chainLaplacianTop() const;
   /// Adds the coupling `coefficient` (N/m or kg/s) of every neighbour pair to a matrix being assembled.
   template <class Add>
   void addNeighbourCoupling(Add&& add, double coefficient) const {

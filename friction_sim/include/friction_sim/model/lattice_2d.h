@@ -55,6 +55,11 @@ class Lattice2D : public Model {
   /// The foundation's k_f on the node's u_z.
   void releaseContact(SparseMatrix& stiffness, int node) const override;
   SparseMatrix dampingMatrix() const override;
+  Vector anchorStiffness() const override;
+  /// 6k: the infinite lattice's largest, at the wave vector (π/l, 0).
+  double bondStiffnessBound() const override { return 6.0 * k_; }
+  /// 12η: the infinite lattice's largest, at the wave vector (π/l, 0).
+  double dampingBound() const override { return 12.0 * eta_; }
   bool rebalanceLoad(const Vector& u) override;
   /// Every bottom node's x (InterfaceLoading::Stuck), or only the middle one's, which takes out the
   /// free slider's rigid translation and carries no force (InterfaceLoading::Free).

@@ -130,6 +130,17 @@ class Model {
   virtual void releaseContact(SparseMatrix& stiffness, int node) const = 0;
   /// Damping matrix of the pair damping (force = −C·v).
   virtual SparseMatrix dampingMatrix() const = 0;
+  /// N/m per degree of freedom: the springs that tie single degrees of freedom to the ground (foundation,
+  /// pusher, top springs), the diagonal part of stiffnessMatrix() that no bond between nodes gives.
+  virtual Vector anchorStiffness() const = 0;
+  /// Upper bounds on the largest eigenvalues of the bonds' part of stiffnessMatrix() (N/m) and of
+  /// dampingMatrix() (kg/s), in closed form: with modeBounds' node-by-node bound they set the stability
+  /// limit without an eigenvalue solve. A finite lattice is the infinite one with bonds taken away, and
+  /// taking a bond away lowers the quadratic form uᵀKu, so its largest eigenvalue is at most the
+  /// infinite lattice's: the top of the symbol Σ_bonds k_b (2 − 2cos q·d_b) e_b e_bᵀ over the wave
+  /// vectors q.
+  virtual double bondStiffnessBound() const = 0;
+  virtual double dampingBound() const = 0;
 
   /// Degrees of freedom held fixed while F_Z is applied (the interface's tangential motion).
   virtual std::vector<int> blockedDofsDuringLoading() const;
@@ -165,6 +176,12 @@ class Model {
   virtual GaugeStresses nodeStresses(const Vector& u) const = 0;
   /// Nodes along x and along z (the chain: N × 1).
   virtual std::array<int, 2> gridShape() const = 0;
+  /// Degrees of freedom per node (x, and z in 2D): component c of node i is degree of freedom c·N + i
+  /// of the N nodes of the grid.
+  int componentsPerNode() const {
+    const auto shape = gridShape();
+    return dofCount() / (shape[0] * shape[1]);
+  }
   /// m, rest spacing of the nodes (l or a).
   virtual double nodeSpacing() const = 0;
 };

@@ -76,10 +76,11 @@ std::unique_ptr<Integrator> buildIntegrator(IntegratorKind kind);
 /// of the damped oscillator u'' = −ω²u − c·u'.
 double stabilityLimit(IntegratorKind kind, double omega_max, double damping_rate);
 
-/// ω_max (rad/s) and c_max (1/s) of a model (with the interfacial stiffness k_T on its interface dofs).
+/// Upper bounds on ω_max (rad/s) and c_max (1/s) of a model (with the interfacial stiffness k_T on its
+/// interface dofs), from Model's closed-form bounds: no eigenvalue solve.
 struct ModeBounds {
-  double omega_max = 0.0;     ///< rad/s, the highest angular frequency of the undamped model
-  double damping_rate = 0.0;  ///< 1/s, the highest damping rate c of its modes
+  double omega_max = 0.0;     ///< rad/s, at least the highest angular frequency of the undamped model
+  double damping_rate = 0.0;  ///< 1/s, at least the highest damping rate c of its modes
 };
 ModeBounds modeBounds(const Model& model, double interfacial_stiffness);
 

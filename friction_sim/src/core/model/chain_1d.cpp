@@ -57,6 +57,11 @@ void Chain1D::updateDrivingStiffness() {
   }
 }
 
+double Chain1D::chainLaplacianTop() const {
+  const double pi = std::acos(-1.0);
+  return n_ > 1 ? 2.0 * (1.0 + std::cos(pi / n_)) : 0.0;
+}
+
 double Chain1D::torqueCoefficient(double shear_force) const {
   return xi_square_sum_ > 0.0 ? 2.0 * torque_share_ * pushing_height_ * shear_force / (length_ * xi_square_sum_) : 0.0;
 }

@@ -369,8 +369,9 @@ double Lattice2D::externalWork(const Vector& u_from, const Vector& u_to) const {
 }
 
 SparseMatrix Lattice2D::stiffnessMatrix() const {
+  const Vector anchors = anchorStiffness();
   // A node and its eight neighbours, two components each.
-  return assembleSparse(2 * n_, 18, [this](auto&& add) {
+  return assembleSparse(2 * n_, 18, [this, &anchors](auto&& add) {
     for (const BondFamily& family : families_) {
       const double e[2] = {family.ex, family.ez};
       forEachBond(family, [&](int a, int b) {
@@ -387,18 +388,26 @@ SparseMatrix Lattice2D::stiffnessMatrix() const {
         }
       });
     }
-    for (int i = 0; i < nx_; ++i) {
-      add(zDof(i), zDof(i), kf_);
-      if (mattress_) {
-        const int top = nodeIndex(i, nz_ - 1);
-        add(zDof(top), zDof(top), mattress_k_);
-        add(xDof(top), xDof(top), mattress_kx_per_node_);
-      }
-    }
-    if (pusher_connected_) {
-      for (int row : pushed_rows_) add(xDof(nodeIndex(0, row)), xDof(nodeIndex(0, row)), pusher_k_per_row_);
+    for (int dof = 0; dof < 2 * n_; ++dof) {
+      if (anchors[dof] != 0.0) add(dof, dof, anchors[dof]);
     }
   });
+}
+
+Vector Lattice2D::anchorStiffness() const {
+  Vector anchors = Vector::Zero(2 * n_);
+  for (int i = 0; i < nx_; ++i) {
+    anchors[zDof(i)] += kf_;
+    if (mattress_) {
+      const int top = nodeIndex(i, nz_ - 1);
+      anchors[zDof(top)] += mattress_k_;
+      anchors[xDof(top)] += mattress_kx_per_node_;
+    }
+  }
+  if (pusher_connected_) {
+    for (int row : pushed_rows_) anchors[xDof(nodeIndex(0, row))] += pusher_k_per_row_;
+  }
+  return anchors;
 }
 
 void Lattice2D::releaseContact(SparseMatrix& stiffness, int node) const {

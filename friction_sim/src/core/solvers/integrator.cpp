@@ -1,8 +1,8 @@
 #include "friction_sim/solvers/integrator.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
-#include <vector>
 
 #include "friction_sim/model/model.h"
 
@@ -101,38 +101,24 @@ double spectralRadius(IntegratorKind kind, double omega, double damping_rate, do
   return map.eigenvalues().cwiseAbs().maxCoeff();
 }
 
-/// Largest eigenvalue of a symmetric matrix by Lanczos iteration: its top Ritz value converges far
-/// faster than power iteration when the top of the spectrum is dense, as it is for large lattices
-/// (power iteration needed thousands of products at 10⁶ nodes). Approaches from below.
-double largestEigenvalue(const SparseMatrix& matrix) {
-  const int n = static_cast<int>(matrix.rows());
-  if (n == 0) return 0.0;
-  constexpr int kMaxSteps = 400;
-  // Start close to the grid-scale (alternating) modes, with every other mode present too.
-  Vector q(n), previous = Vector::Zero(n), w(n);
-  for (int i = 0; i < n; ++i) q[i] = (i % 2 ? -1.0 : 1.0) * (1.0 + 0.3 * std::sin(1.7 * i + 0.3));
-  q.normalize();
-  std::vector<double> alpha, beta;
-  double estimate = 0.0, beta_previous = 0.0;
-  for (int step = 0; step < std::min(n, kMaxSteps); ++step) {
-    w.noalias() = matrix * q;
-    alpha.push_back(q.dot(w));
-    w -= alpha.back() * q + beta_previous * previous;
-    const double beta_next = w.norm();
-    // The tridiagonal projection's largest eigenvalue is the estimate.
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> projection;
-    projection.computeFromTridiagonal(Eigen::Map<const Vector>(alpha.data(), alpha.size()),
-                                      Eigen::Map<const Vector>(beta.data(), beta.size()), Eigen::EigenvaluesOnly);
-    const double ritz = projection.eigenvalues().maxCoeff();
-    const bool converged = step > 5 && std::abs(ritz - estimate) <= 1e-9 * std::abs(ritz);
-    estimate = ritz;
-    if (converged || beta_next <= 1e-14 * std::abs(ritz)) break;
-    beta.push_back(beta_next);
-    previous.swap(q);
-    q = w / beta_next;
-    beta_previous = beta_next;
+/// λ_max of a symmetric matrix of one or two rows, given as its diagonal d and off-diagonal entry e.
+double blockTop(double d0, double d1, double e) { return 0.5 * (d0 + d1) + std::hypot(0.5 * (d0 - d1), e); }
+
+/// An upper bound on λ_max(K), K = B + A with B the bonds' part and A the anchors (diagonal): since
+/// (x − y)² ≤ 2x² + 2y², a bond's k_b(e_b·(u_a − u_b))² is at most twice its share of the diagonal
+/// blocks of its two nodes, so uᵀKu ≤ Σ_nodes u_iᵀ(2B_ii + A_ii)u_i and λ_max(K) ≤ max_i λ_max(2K_ii − A_ii).
+/// At an interior node of the lattice this is 6k, the infinite lattice's top; at its edges nodes have
+/// fewer bonds, which leaves room for the anchors there.
+double nodeByNodeBound(const SparseMatrix& stiffness, const Vector& anchors, int components) {
+  const int nodes = static_cast<int>(anchors.size()) / components;
+  double bound = 0.0;
+  for (int node = 0; node < nodes; ++node) {
+    const int x = node, z = nodes + node;
+    auto doubled = [&](int dof) { return 2.0 * stiffness.coeff(dof, dof) - anchors[dof]; };
+    bound =
+        std::max(bound, components == 1 ? doubled(x) : blockTop(doubled(x), doubled(z), 2.0 * stiffness.coeff(x, z)));
   }
-  return estimate;
+  return bound;
 }
 
 }  // namespace
@@ -157,15 +143,19 @@ double stabilityLimit(IntegratorKind kind, double omega_max, double damping_rate
 
 ModeBounds modeBounds(const Model& model, double interfacial_stiffness) {
   SparseMatrix stiffness = model.stiffnessMatrix();
+  Vector anchors = model.anchorStiffness();
   for (int node = 0; node < model.interfaceNodeCount(); ++node) {
     const int dof = model.interfaceDof(node);
     stiffness.coeffRef(dof, dof) += interfacial_stiffness;
+    anchors[dof] += interfacial_stiffness;
   }
-  // Lanczos approaches from below; 1 % covers what is left after it stops.
-  constexpr double kMargin = 1.01;
+  // Two bounds, each close where the other is loose: the bonds' closed form plus the largest anchor
+  // (the anchors are a diagonal matrix), and the node-by-node bound, which sees where the anchors are.
+  const double stiffness_bound = std::min(model.bondStiffnessBound() + anchors.maxCoeff(),
+                                          nodeByNodeBound(stiffness, anchors, model.componentsPerNode()));
   ModeBounds bounds;
-  bounds.omega_max = std::sqrt(kMargin * largestEigenvalue(stiffness) / model.nodeMass());
-  bounds.damping_rate = kMargin * largestEigenvalue(model.dampingMatrix()) / model.nodeMass();
+  bounds.omega_max = std::sqrt(stiffness_bound / model.nodeMass());
+  bounds.damping_rate = model.dampingBound() / model.nodeMass();
   return bounds;
 }
 

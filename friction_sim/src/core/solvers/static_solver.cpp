@@ -49,7 +49,7 @@ SparseMatrix freeStiffness(const Model& model, const std::vector<int>& lifted_no
 /// The model's dofs as a grid of nodes (every model is one: the chain's is n × 1).
 GridLayout gridLayoutOf(const Model& model) {
   const auto shape = model.gridShape();
-  return {shape[0], shape[1], model.dofCount() / (shape[0] * shape[1])};
+  return {shape[0], shape[1], model.componentsPerNode()};
 }
 }  // namespace
 
