@@ -8,6 +8,7 @@ import re
 import unittest
 
 import roslaunch.config
+import roslaunch.rlutil
 import rosunit
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -48,6 +49,11 @@ def names_in_rig_rviz():
 
 
 class LaunchFilesTest(unittest.TestCase):
+    def test_every_launch_file_is_found_by_package_name(self):
+        for name in sorted(os.listdir(LAUNCH)):
+            resolved = roslaunch.rlutil.resolve_launch_arguments(["friction_sim", name])
+            self.assertEqual(os.path.realpath(resolved[0]), os.path.join(os.path.realpath(LAUNCH), name))
+
     def check_rviz_follows(self, config, namespace):
         remaps = dict(node(config, "rviz").remap_args)
         for name in names_in_rig_rviz():
