@@ -2,13 +2,19 @@
 # Runs roslaunch with a private master bound to localhost on a free port, so that the rig neither
 # disturbs another ROS system on the machine nor listens on the network.
 #   scripts/rig_launch.sh launch/rig.launch [arg:=value]...
+#   scripts/rig_launch.sh friction_sim rig.launch [arg:=value]...   (or any package's launch file)
+# The caller's environment stays (their overlay and packages: a launch file may start their own nodes);
+# the rig's workspace is added to it. Output that is not a terminal carries no colour or title codes.
 # Exit status: 0 only if roslaunch and every node it ran ended cleanly. roslaunch itself exits 0 when a
 # node refuses its scene or protocol or crashes, so the nodes' exit codes are read from roslaunch's log
 # afterwards and a failing node is named, with status 1, so that scripts and sweeps can tell a failed
 # run from a run. 130 when interrupted (Ctrl-C, kill, hang-up), after roslaunch has stopped every node.
 set -euo pipefail
 source "$(dirname "$0")/ros_env.sh"
-set +u; source "$RIG_WS/devel/setup.bash"; set -u
+caller_package_path="${ROS_PACKAGE_PATH:-}"
+set +u; source "$RIG_WS/devel/setup.bash" --extend; set -u
+# The setup rebuilds ROS_PACKAGE_PATH from the workspaces: packages the caller listed by hand stay too.
+export ROS_PACKAGE_PATH="$ROS_PACKAGE_PATH${caller_package_path:+:$caller_package_path}"
 port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 export ROS_MASTER_URI="http://127.0.0.1:$port" ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1
 export ROS_HOME="${ROS_HOME:-$RIG_WS/ros_home}"
@@ -27,13 +33,26 @@ for argument in "$@"; do
   arguments+=("$argument")
 done
 
+# roslaunch colours its own lines and sets the terminal's title, and rosconsole colours warnings,
+# whatever the output is: into a file or a pipe they go through a filter that drops the codes.
+without_codes() { sed -u -E $'s/\x1b\\][^\x07]*\x07//g; s/\x1b\\[[0-9;?]*[A-Za-z]//g'; }
+filters=()
+launch_options=()
+if [ -t 1 ]; then exec 3>&1; else exec 3> >(trap "" INT TERM HUP; without_codes); filters+=($!); launch_options+=(--disable-title); fi
+if [ -t 2 ]; then exec 4>&2; else exec 4> >(trap "" INT TERM HUP; without_codes >&2); filters+=($!); fi
+
 launched_after=$(mktemp)
-trap 'rm -f "$launched_after"' EXIT
+finish() {
+  rm -f "$launched_after"
+  exec 3>&- 4>&-
+  [ "${#filters[@]}" -eq 0 ] || wait "${filters[@]}" 2>/dev/null || true
+}
+trap finish EXIT
 # roslaunch runs as a job of its own, so that this script can read its log when it ends and pass on a
 # signal meanwhile; job control keeps it from starting with SIGINT ignored, as a script's background
 # jobs otherwise do. Every signal is passed on as SIGINT, on which roslaunch stops its nodes cleanly.
 set -m
-roslaunch --port "$port" "${arguments[@]}" &
+roslaunch --port "$port" "${launch_options[@]}" "${arguments[@]}" >&3 2>&4 &
 launch_pid=$!
 interrupted=0
 trap 'interrupted=1; kill -INT "$launch_pid" 2>/dev/null || true' INT TERM HUP

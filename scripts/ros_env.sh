@@ -2,8 +2,9 @@
 # A pyenv or virtualenv python3 earlier on PATH lacks catkin_pkg and breaks catkin with odd errors.
 export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export PYTHON_EXECUTABLE=/usr/bin/python3
-if [ -f /opt/ros/noetic/setup.bash ]; then
-  # Ubuntu with ROS Noetic from packages.ros.org
+if [ -z "${ROS_DISTRO:-}" ] && [ -f /opt/ros/noetic/setup.bash ]; then
+  # Ubuntu with ROS Noetic from packages.ros.org, unless a ROS environment (the user's overlay on it)
+  # is set up already: sourcing it again would drop that overlay.
   set +u; source /opt/ros/noetic/setup.bash; set -u
 fi
 RIG_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -2,7 +2,8 @@
 """scripts/rig_launch.sh's exit status: roslaunch itself exits 0 when a node refuses its input or
 crashes, so the script reads the nodes' exit codes and fails, naming the node; a run that ends cleanly
 exits 0, an interrupted one 130 after every node has stopped. Each launch brings up its own private
-master on a free port."""
+master on a free port. It keeps the caller's packages (a launch file of their own, by package name,
+with a node of their own) and writes no terminal codes into a pipe."""
 import os
 import shutil
 import signal
@@ -85,9 +86,21 @@ class SlowRun:
             self.process.wait()
 
 
-def launch(*args, cwd=None):
-    done = subprocess.run([RIG_LAUNCH, RIG] + list(args), capture_output=True, text=True, timeout=120, cwd=cwd)
+def launch(*args, cwd=None, env=None, launch_file=(RIG,)):
+    done = subprocess.run([RIG_LAUNCH] + list(launch_file) + list(args), capture_output=True, text=True, timeout=120,
+                          cwd=cwd, env=env)
     return done.returncode, done.stdout + done.stderr
+
+
+USERS_LAUNCH = """<launch>
+  <include file="$(find friction_sim)/launch/rig.launch">
+    <arg name="scene" value="%s"/>
+    <arg name="controller" value="false"/>
+    <arg name="analysis" value="false"/>
+  </include>
+  <node pkg="users_analysis" type="mark_run" name="mark_run"/>
+</launch>
+"""
 
 
 class RigLaunchStatusTest(unittest.TestCase):
@@ -164,6 +177,31 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertIn("reached 3 global slip event(s)", output)
         self.assertRegex(output, r"mu_s,macro = F_X/F_Z at the first global event: 0\.4\n")
         self.assertNotIn("rig_launch: failed", output)
+        # Into a pipe: no colour codes, no terminal title.
+        self.assertNotIn("\x1b", output)
+
+    def test_a_users_package_launches_the_rig_by_package_name_and_its_own_node(self):
+        # A package of the user's, listed by hand on ROS_PACKAGE_PATH: its launch file includes the rig's
+        # by package name and starts a node of its own, which marks that it ran.
+        work = tempfile.mkdtemp(prefix="rig_launch_test_")
+        self.addCleanup(shutil.rmtree, work)
+        package = os.path.join(work, "users_analysis")
+        os.makedirs(os.path.join(package, "launch"))
+        with open(os.path.join(package, "package.xml"), "w") as handle:
+            handle.write('<package format="2"><name>users_analysis</name><version>0.0.0</version>'
+                         '<description>test</description><maintainer email="a@b.c">a</maintainer>'
+                         '<license>BSD</license></package>\n')
+        with open(os.path.join(package, "launch/users.launch"), "w") as handle:
+            handle.write(USERS_LAUNCH % SINGLE_BLOCK)
+        marker = os.path.join(package, "mark_run")
+        with open(marker, "w") as handle:
+            handle.write('#!/bin/sh\ntouch "$(dirname "$0")/ran"\n')
+        os.chmod(marker, 0o755)
+        env = dict(os.environ, ROS_PACKAGE_PATH=package + os.pathsep + os.environ.get("ROS_PACKAGE_PATH", ""))
+        status, output = launch(env=env, launch_file=("users_analysis", "users.launch"))
+        self.assertEqual(status, 0, output)
+        self.assertIn("reached 3 global slip event(s)", output)
+        self.assertTrue(os.path.exists(os.path.join(package, "ran")), output)
 
 
 if __name__ == "__main__":
