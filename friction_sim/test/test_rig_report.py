@@ -34,13 +34,16 @@ def event(index, onset, shear_ratio, rupture_length, slider_length=0.14):
 
 
 def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=None, normal_load_rise=0.0,
-              commands=True, scene_again=None, resets=0, first_resets=0, ageing=False):
+              commands=True, scene_again=None, resets=0, first_resets=0, ageing=False, frames_from=0,
+              frames_lost=(), events_lost=()):
     """Load cells and frames for 0.1 s (F_Z rising by `normal_load_rise` N per ms), two events from the
     simulator and, unless not `detector`, the same two, with the detector's slightly later reading of F_X,
     from the detector; `also` another rig's namespace with the same; unless not `commands`, a drive and a
     normal-load command as applied; `scene_again` a second scene message (the rig's with its run end);
     stage states counting `resets` during the recording, from `first_resets` before it; with `ageing`,
-    frames whose static coefficients rise with time."""
+    frames whose static coefficients rise with time; `frames_from` the index of the first frame written,
+    `frames_lost` and `events_lost` the indices of frames and events left out, as a late or lossy recorder
+    leaves them."""
     if also:
         write_bag(path + ".also", also, detector, slider_length)
     with rosbag.Bag(path, "w") as bag:
@@ -69,6 +72,9 @@ def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=No
             bag.write(namespace + "/load_cells", wrench, stamp)
             frame = InterfaceState()
             frame.header.stamp = stamp
+            frame.frame_index = step - 1
+            if frame.frame_index < frames_from or frame.frame_index in frames_lost:
+                continue
             frame.position = [0.0, 0.07, 0.14]
             frame.slip_velocity = [0.0, 0.0, 0.0]
             frame.state = [0, 0, 0]
@@ -77,7 +83,8 @@ def write_bag(path, namespace="/rig", detector=True, slider_length=0.14, also=No
         sources = [("/slip_events", 0.0)] + ([("/precursor_detector/slip_events", 1e-4)] if detector else [])
         for source, later in sources:
             for msg in [event(0, 0.03, 0.1 + later, 0.05, slider_length), event(1, 0.08, 0.2 + later, 0.14, slider_length)]:
-                bag.write(namespace + source, msg, msg.header.stamp)
+                if msg.index not in events_lost:
+                    bag.write(namespace + source, msg, msg.header.stamp)
 
 
 class RigReportTest(unittest.TestCase):
@@ -151,6 +158,18 @@ class RigReportTest(unittest.TestCase):
         done = self.report()
         self.assertNotIn("reset", done.stdout)
         self.assertIn("friction_run", done.stdout)
+
+    def test_a_partial_bag_is_reported_and_offers_no_rerun(self):
+        done = self.report()
+        self.assertNotIn("partial", done.stdout)
+        for kwargs, lacks in [({"frames_from": 23}, "the interface frames before number 23 (the start of the run)"),
+                              ({"frames_lost": (40, 41, 70)}, "3 interface frames between the recorded ones"),
+                              ({"events_lost": (0,)}, "the slip events before number 1")]:
+            write_bag(self.bag, **kwargs)
+            done = self.report()
+            self.assertEqual(done.returncode, 0, done.stderr)
+            self.assertIn("rig_report: warning: the bag is partial: it lacks " + lacks, done.stdout)
+            self.assertNotIn("friction_run", done.stdout)
 
     def test_the_detectors_events_on_request(self):
         done = self.report("--events", "detector")
