@@ -18,7 +18,7 @@ rm -f "${outputs[@]/#/$out/}"
 # ignores Ctrl-C and reads on while rig_launch stops the rig: roslaunch must not lose its output midway.
 launch_statuses=(0 0)
 "$RIG_ROOT/scripts/rig_launch.sh" "$RIG_ROOT/launch/rig.launch" record:=true bag:="$out/run.bag" "$@" 2>&1 \
-  | (trap '' INT; exec grep -vE '^\s*$|killing on exit|shutting down|^\S*\[1m|REQUIRED process|process has finished|log file:|Initiating shutdown|^=+|SUMMARY|PARAMETERS|NODES|auto-starting|^ \* |^    ') \
+  | (trap '' INT; exec grep -vE '^\s*$|killing on exit|shutting down|^started roslaunch server|^process\[|^ROS_MASTER_URI=|^setting /run_id|^done$|REQUIRED process|process has finished|log file:|Initiating shutdown|^=+|SUMMARY|PARAMETERS|NODES|auto-starting|^ \* |^    ') \
   || launch_statuses=("${PIPESTATUS[@]}")
 case "${launch_statuses[0]}" in
   0) ;;
