@@ -6,6 +6,7 @@ argument of rig.launch passed on."""
 import os
 import re
 import unittest
+from xml.etree import ElementTree
 
 import roslaunch.config
 import roslaunch.rlutil
@@ -91,6 +92,21 @@ class LaunchFilesTest(unittest.TestCase):
         self.assertFalse(node(alone, "simulator").required)
         self.assertEqual(config.params["/bench/simulator/start_paused"].value, True)
         self.assertEqual(alone.params["/rig/simulator/start_paused"].value, False)
+
+    def test_multi_machine_declares_and_passes_on_every_argument_of_the_rig(self):
+        def arguments(launch_file):
+            return ElementTree.parse(os.path.join(LAUNCH, launch_file)).getroot()
+        rig = {arg.get("name") for arg in arguments("rig.launch").findall("arg")} - {"simulator_machine"}
+        multi = arguments("multi_machine.launch")
+        self.assertLessEqual(rig, {arg.get("name") for arg in multi.findall("arg")})
+        passed = {arg.get("name"): arg.get("value") for arg in multi.find("include").findall("arg")}
+        for name in rig:
+            self.assertEqual(passed.get(name), "$(arg %s)" % name, name)
+
+    def test_the_simulator_waits_for_the_subscribers_it_is_given(self):
+        config = load("rig.launch", "wait_for_subscribers:=load_cells interface:2", "subscriber_timeout:=5")
+        self.assertEqual(config.params["/rig/simulator/wait_for_subscribers"].value, "load_cells interface:2")
+        self.assertEqual(config.params["/rig/simulator/subscriber_timeout"].value, 5)
 
     def test_the_rig_runs_on_this_machine_by_default(self):
         config = load("rig.launch")

@@ -5,6 +5,7 @@ exits 0, an interrupted one 130 after every node has stopped. Each launch brings
 master on a free port. It keeps the caller's packages (a launch file of their own, by package name,
 with a node of their own) and writes no terminal codes into a pipe."""
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -179,6 +180,30 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertNotIn("rig_launch: failed", output)
         # Into a pipe: no colour codes, no terminal title.
         self.assertNotIn("\x1b", output)
+
+    def test_a_simulator_told_to_wait_for_subscribers_that_never_come_fails_naming_them(self):
+        self.assert_launch_fails(["scene:=" + SINGLE_BLOCK, "controller:=false", "wait_for_subscribers:=load_cells",
+                                  "subscriber_timeout:=1"],
+                                 "still waiting for subscribers of /rig/load_cells (0 of 1)",
+                                 "rig_launch: failed: rig_simulator (exit code 5)")
+        self.assert_launch_fails(["wait_for_subscribers:=load_cells:0 camera"],
+                                 "~wait_for_subscribers: item 'load_cells:0' is not allowed",
+                                 "~wait_for_subscribers: item 'camera' is not allowed",
+                                 "rig_launch: failed: rig_simulator (exit code 2)")
+
+    def test_a_subscriber_that_comes_late_sees_the_run_from_its_first_frame(self):
+        process = subprocess.Popen([RIG_LAUNCH, RIG, "scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false",
+                                    "wait_for_subscribers:=interface"], stdout=subprocess.PIPE,
+                                   stderr=subprocess.STDOUT, text=True)
+        self.addCleanup(lambda: process.poll() is None and process.kill())
+        master = re.search(r"private master at (\S+);", process.stdout.readline()).group(1)
+        threading.Event().wait(3.0)  # the rig is up and waits; a recorder started late
+        seen = subprocess.run(["rostopic", "echo", "-n", "1", "/rig/interface/frame_index"], capture_output=True,
+                              text=True, timeout=60, env=dict(os.environ, ROS_MASTER_URI=master))
+        output = process.communicate(timeout=120)[0]
+        self.assertEqual(process.returncode, 0, output)
+        self.assertEqual(seen.stdout.split(), ["0", "---"], seen.stderr)
+        self.assertIn("reached 3 global slip event(s)", output)
 
     def test_a_users_package_launches_the_rig_by_package_name_and_its_own_node(self):
         # A package of the user's, listed by hand on ROS_PACKAGE_PATH: its launch file includes the rig's

@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
     friction::RigSimulator simulator{ros::NodeHandle(), friction::readSimulatorOptions(ros::NodeHandle("~"))};
     simulator.run();
     if (simulator.aborted()) return 4;
+    if (simulator.subscribersMissing()) return 5;
   } catch (const friction::ConfigError& error) {
     std::cerr << ros::this_node::getName() << ": " << error.what() << std::endl;
     return 2;

@@ -29,6 +29,59 @@ std::optional<rosbag::compression::CompressionType> bagCompression(const std::st
 }
 }  // namespace
 
+const std::vector<std::pair<std::string, ros::Publisher RigSimulator::*>>& RigSimulator::waitablePublishers() {
+  static const std::vector<std::pair<std::string, ros::Publisher RigSimulator::*>> publishers = {
+      {"load_cells", &RigSimulator::load_cells_pub_},
+      {"strain_gauges", &RigSimulator::gauges_pub_},
+      {"interface", &RigSimulator::interface_pub_},
+      {"slip_events", &RigSimulator::events_pub_},
+      {"lattice", &RigSimulator::lattice_pub_},
+      {"stage_state", &RigSimulator::stage_pub_},
+      {"applied_commands", &RigSimulator::applied_commands_pub_},
+      {"scene", &RigSimulator::scene_pub_}};
+  return publishers;
+}
+
+std::vector<std::string> RigSimulator::waitableTopics() {
+  std::vector<std::string> topics;
+  for (const auto& publisher : waitablePublishers()) topics.push_back(publisher.first);
+  return topics;
+}
+
+std::vector<std::pair<std::string, int>> parseAwaitedSubscribers(const std::string& text,
+                                                                 std::vector<std::string>& problems) {
+  const std::vector<std::string> topics = RigSimulator::waitableTopics();
+  std::vector<std::pair<std::string, int>> awaited;
+  std::istringstream items(text);
+  std::string item;
+  while (items >> item) {
+    const std::size_t colon = item.find(':');
+    const std::string topic = item.substr(0, colon);
+    int count = 1;
+    bool ok = std::find(topics.begin(), topics.end(), topic) != topics.end();
+    if (ok && colon != std::string::npos) {
+      std::size_t used = 0;
+      try {
+        count = std::stoi(item.substr(colon + 1), &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      ok = used > 0 && colon + 1 + used == item.size() && count >= 1;
+    }
+    if (!ok) {
+      std::string allowed;
+      for (const std::string& name : topics) allowed += (allowed.empty() ? "" : ", ") + name;
+      problems.push_back("~wait_for_subscribers: item '" + item +
+                         "' is not allowed; allowed: topic[:count] with "
+                         "a topic of " +
+                         allowed + " and a count >= 1");
+      continue;
+    }
+    awaited.emplace_back(topic, count);
+  }
+  return awaited;
+}
+
 std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   std::vector<std::string> problems;
   auto require = [&](bool ok, const std::string& name, double value, const std::string& allowed) {
@@ -48,6 +101,9 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
     problems.push_back("~bag_compression: value '" + o.bag_compression + "' is not allowed; allowed: lz4, bz2, none");
   }
   parseOverrides(o.overrides, problems);
+  parseAwaitedSubscribers(o.wait_for_subscribers, problems);
+  require(std::isfinite(o.subscriber_timeout) && o.subscriber_timeout > 0.0, "subscriber_timeout", o.subscriber_timeout,
+          "> 0 s");
   return problems;
 }
 
@@ -69,6 +125,8 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   readParameter(pnh, "frame_id", o.frame_id);
   readParameter(pnh, "stop_at_scene_end", o.stop_at_scene_end);
   readParameter(pnh, "start_paused", o.start_paused);
+  readParameter(pnh, "wait_for_subscribers", o.wait_for_subscribers);
+  readParameter(pnh, "subscriber_timeout", o.subscriber_timeout);
   refuseParameters(pnh, validateOptions(o));
   return o;
 }
@@ -84,6 +142,7 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
     : nh_(std::move(nh)), options_(std::move(options)) {
   std::vector<std::string> problems;
   const auto overrides = parseOverrides(options_.overrides, problems);
+  awaited_subscribers_ = parseAwaitedSubscribers(options_.wait_for_subscribers, problems);
   scene_ = loadScene(options_.scene_path, overrides, &stability_limit_);
   for (const std::string& warning : sceneWarnings(scene_)) ROS_WARN_STREAM("scene: " << warning);
   wave_speeds_ = waveSpeeds(scene_);
@@ -347,7 +406,47 @@ void RigSimulator::pace() {
   if (ahead > 1e-3) ros::WallDuration(ahead).sleep();
 }
 
-void RigSimulator::run() { finish(runUntilTheEnd()); }
+void RigSimulator::run() {
+  if (waitForSubscribers()) {
+    finish(runUntilTheEnd());
+    return;
+  }
+  subscribers_missing_ = true;
+  finish("not started: subscribers missing");
+}
+
+bool RigSimulator::waitForSubscribers() {
+  if (awaited_subscribers_.empty()) return true;
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.subscriber_timeout);
+  while (!g_stop_requested && ros::ok()) {
+    const std::string missing = missingSubscribers();
+    if (missing.empty()) return true;
+    if (ros::WallTime::now() >= deadline) {
+      ROS_ERROR_STREAM("no run: after " << options_.subscriber_timeout << " s (~subscriber_timeout) still waiting "
+                                        << "for subscribers of " << missing << " (~wait_for_subscribers)");
+      return false;
+    }
+    ros::spinOnce();
+    publishStageState();
+    publishClock(simulation().time());
+    ros::WallDuration(0.05).sleep();
+  }
+  return true;  // interrupted: the run loop ends at once, with the reason
+}
+
+std::string RigSimulator::missingSubscribers() const {
+  std::string missing;
+  for (const auto& [topic, count] : awaited_subscribers_) {
+    for (const auto& [name, member] : waitablePublishers()) {
+      const ros::Publisher& publisher = this->*member;
+      const int subscribers = static_cast<int>(publisher.getNumSubscribers());
+      if (name != topic || subscribers >= count) continue;
+      missing += (missing.empty() ? "" : ", ") + publisher.getTopic() + " (" + std::to_string(subscribers) + " of " +
+                 std::to_string(count) + ")";
+    }
+  }
+  return missing;
+}
 
 std::string RigSimulator::runUntilTheEnd() {
   ros::WallTime next_spin = ros::WallTime::now();

@@ -18,6 +18,13 @@
 //   stop_at_scene_end (bool, true)  end when the scene's stop condition holds
 //   start_paused (bool, false)      wait at t = 0 until `pause` is called with false (a controller
 //                                   sends its schedule first, so every command is on time)
+//   wait_for_subscribers (string, "")  wait at t = 0 until these topics have subscribers: "topic[:count]
+//                                   ...", topics of the list below by their relative names (e.g.
+//                                   "load_cells interface:2 slip_events"), a count of 1 if not given; so
+//                                   that a recorder or an analysis node started with the rig sees the run
+//                                   from its start
+//   subscriber_timeout (double, 30) s of wall time to wait for them; then the node logs the topics still
+//                                   short of subscribers and exits with status 5, the run not started
 //
 // Published topics (relative to the node's namespace; stamps are simulated time):
 //   /clock (rosgraph_msgs/Clock)                   simulated time; at 20 Hz of wall time while paused
@@ -58,7 +65,8 @@
 //   summary printed when the node ends is then the run since the last reset. Its wall time is the time
 //   spent running, not waiting paused.
 // Exit status: 0 when the run ended (its end, stop, a signal, ROS shut down), 2 when the scene or a
-// parameter is refused, 4 when the run was aborted.
+// parameter is refused, 4 when the run was aborted, 5 when ~wait_for_subscribers' subscribers did not
+// come within ~subscriber_timeout.
 //
 // Commands with NaN/inf, a normal load <= 0 or beyond largestNormalForce (5 % of E over the slider's
 // base), a speed beyond the scene's stage.max_speed or an unknown mode are refused with a logged reason; the simulation
@@ -77,6 +85,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "friction_sim/ros/conversions.h"
@@ -102,7 +111,13 @@ struct SimulatorOptions {
   std::string frame_id = "slider";      ///< frame of every message, the slider's (x along the track, z up)
   bool stop_at_scene_end = true;        ///< end the run when the scene's stop condition holds
   bool start_paused = false;            ///< wait at t = 0 until `pause` is called with false
+  std::string wait_for_subscribers;     ///< "topic[:count] ...": wait at t = 0 until they subscribe
+  double subscriber_timeout = 30.0;     ///< s of wall time to wait for them
 };
+
+/// ~wait_for_subscribers parsed: each topic (relative name) with its count; a problem for each bad item.
+std::vector<std::pair<std::string, int>> parseAwaitedSubscribers(const std::string& text,
+                                                                 std::vector<std::string>& problems);
 
 /// Every problem of the options, each naming the parameter, the value and the allowed range.
 std::vector<std::string> validateOptions(const SimulatorOptions& options);
@@ -123,8 +138,18 @@ class RigSimulator {
   void run();
   /// The run was ended by the `abort` service.
   bool aborted() const { return aborted_; }
+  /// The run never started: ~wait_for_subscribers' subscribers did not come in time.
+  bool subscribersMissing() const { return subscribers_missing_; }
+  /// The topics ~wait_for_subscribers may name, relative to the node's namespace.
+  static std::vector<std::string> waitableTopics();
 
  private:
+  /// The publishers ~wait_for_subscribers may name, by their topics' relative names.
+  static const std::vector<std::pair<std::string, ros::Publisher RigSimulator::*>>& waitablePublishers();
+  /// Waits at t = 0, answering services, until ~wait_for_subscribers holds; false if its timeout passed.
+  bool waitForSubscribers();
+  /// "topic (n of m)" for each awaited topic short of its subscribers; empty once all have them.
+  std::string missingSubscribers() const;
   /// Spins, pauses, resets, advances and paces until the run ends; returns why it ended.
   std::string runUntilTheEnd();
   /// The stage state, the summary and the bag at the end of the run.
@@ -173,6 +198,8 @@ class RigSimulator {
   bool paused_ = false;
   bool stop_ = false;
   bool aborted_ = false;
+  bool subscribers_missing_ = false;
+  std::vector<std::pair<std::string, int>> awaited_subscribers_;  ///< ~wait_for_subscribers, parsed
   bool reset_requested_ = false;
   int scenes_recorded_ = 0;   ///< scene messages written to the bag
   std::uint32_t resets_ = 0;  ///< resets so far, in stage_state: a controller cannot always tell one by the time
