@@ -208,7 +208,7 @@ class RigReportTest(unittest.TestCase):
         self.assertEqual(done.returncode, 0, done.stderr)
 
     def test_a_changing_normal_load_gets_a_panel_of_its_own(self):
-        # The loading curve is 3.6 inches high at 110 dpi, 5 with F_Z's panel below it.
+        # The loading curve is 3.6 inches high at 150 dpi, 5 with F_Z's panel below it.
         def figure_height():
             with open(os.path.join(self.work, "loading_curve.png"), "rb") as png:
                 return struct.unpack(">II", png.read(24)[16:24])[1]  # IHDR: width, height
@@ -216,11 +216,32 @@ class RigReportTest(unittest.TestCase):
             write_bag(self.bag, **bag)
             self.assertEqual(self.report().returncode, 0)
             return figure_height()
-        self.assertEqual(height_with(commands=False), 396)
-        self.assertEqual(height_with(commands=True), 550)  # a normal-load command
-        self.assertEqual(height_with(commands=False, normal_load_rise=5.0), 550)  # 500 N over the run
+        self.assertEqual(height_with(commands=False), 540)
+        self.assertEqual(height_with(commands=True), 750)  # a normal-load command
+        self.assertEqual(height_with(commands=False, normal_load_rise=5.0), 750)  # 500 N over the run
         # A spring mattress's F_Z moves a little with the slider: 0.01 % is no change of the load.
-        self.assertEqual(height_with(commands=False, normal_load_rise=0.002), 396)
+        self.assertEqual(height_with(commands=False, normal_load_rise=0.002), 540)
+
+    def test_figures_for_a_paper_in_every_format_asked_at_the_resolution_asked(self):
+        write_bag(self.bag, commands=False, ageing=True)
+        done = self.report("--format", "png", "pdf", "svg", "--dpi", "300")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        for name in ["loading_curve", "precursors", "slip_map", "static_friction"]:
+            for extension in ["png", "pdf", "svg"]:
+                self.assertIn("%s.%s" % (name, extension), done.stdout.split())
+                self.assertTrue(os.path.exists(os.path.join(self.work, "%s.%s" % (name, extension))))
+        with open(os.path.join(self.work, "loading_curve.png"), "rb") as png:
+            self.assertEqual(struct.unpack(">II", png.read(24)[16:24]), (2100, 1080))  # 7 x 3.6 inches
+        with open(os.path.join(self.work, "loading_curve.pdf"), "rb") as pdf:
+            self.assertEqual(pdf.read(5), b"%PDF-")
+        # Titles name the scene; the maps' rows carry the simulated time.
+        with open(os.path.join(self.work, "loading_curve.svg")) as svg:
+            self.assertIn("synthetic: loading curve", svg.read())
+        with open(os.path.join(self.work, "slip_map.svg")) as svg:
+            text = svg.read()
+            self.assertIn("simulated time t (s), one row per frame", text)
+            self.assertIn("0.001", text)  # the first frame's time, the top row's label
+        self.assertNotEqual(self.report("--dpi", "0").returncode, 0)
 
     def test_an_unknown_slider_length_gives_no_length_ratio(self):
         # The detector's events on a single block without a scene carry L = 0.
