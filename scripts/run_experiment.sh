@@ -2,6 +2,8 @@
 # The README's main command: installs what is missing, builds, runs the default experiment headless
 # (scene pmma_2d, side driving, to the first global slip and three more stick-slip cycles) with the
 # ROS rig on a private localhost master, records a bag, prints the summary and writes the figures.
+# Each run has a folder of its own, results/experiment/<date>_<time>; results/experiment/latest links to
+# the last run that succeeded.
 #   scripts/run_experiment.sh [roslaunch arg:=value]...   e.g. scene:=$PWD/friction_sim/scenes/pmma_1d_side.yaml
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -9,11 +11,9 @@ here="$(cd "$(dirname "$0")/.." && pwd)"
 echo "building (log in .build.log) ..."
 "$here/scripts/build.sh" -j2 >"$here/.build.log" 2>&1 || { tail -n 40 "$here/.build.log"; exit 1; }
 source "$here/scripts/ros_env.sh"
-out="$RIG_ROOT/results/experiment"
+runs="$RIG_ROOT/results/experiment"
+out="$runs/$(date +%Y-%m-%d_%H%M%S)"
 mkdir -p "$out"
-# Nothing of an earlier run may pass for this one's if this run fails.
-outputs=(run.bag loading_curve.png precursors.png slip_map.png events.csv scene.yaml stage_commands.csv)
-rm -f "${outputs[@]/#/$out/}"
 # roslaunch's chatter is filtered out (grep's status is not the rig's; rig_launch's is). The filter
 # ignores Ctrl-C and reads on while rig_launch stops the rig: roslaunch must not lose its output midway.
 launch_statuses=(0 0)
@@ -28,6 +28,5 @@ esac
 [ -f "$out/run.bag" ] || { echo "run_experiment: no bag was written" >&2; exit 1; }
 set +u; source "$RIG_WS/devel/setup.bash"; set -u
 /usr/bin/python3 "$RIG_ROOT/friction_sim/scripts/rig_report" "$out/run.bag" --out "$out"
-written=()
-for output in "${outputs[@]}"; do [ -e "$out/$output" ] && written+=("$output"); done
-echo "results in $out: ${written[*]}"  # without the controller, the scene's own program: no commands
+ln -sfn "$(basename "$out")" "$runs/latest"
+echo "results in $out (results/experiment/latest): $(cd "$out" && echo *)"

@@ -3,10 +3,10 @@
 # written by scripts/run_experiment.sh) into rviz with the rig's configuration on a virtual screen
 # (xvfb-run, Mesa's software GL), at 1/20 of simulated time so that rviz draws what it is sent, and
 # takes a screenshot of rviz on the bag's last state. The figure is replaced only if that worked.
-#   scripts/rviz_figure.sh [BAG] [OUT.png]      defaults: results/experiment/run.bag docs/figures/rviz.png
+#   scripts/rviz_figure.sh [BAG] [OUT.png]      defaults: results/experiment/latest/run.bag docs/figures/rviz.png
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
-bag="$(realpath -m "${1:-$here/results/experiment/run.bag}")"
+bag="$(realpath -m "${1:-$here/results/experiment/latest/run.bag}")"
 out="$(realpath -m "${2:-$here/docs/figures/rviz.png}")"
 [ -f "$bag" ] || { echo "rviz_figure: no bag at $bag (run scripts/run_experiment.sh first)" >&2; exit 1; }
 source "$here/scripts/ros_env.sh"
