@@ -212,6 +212,39 @@ TEST(InvalidScene, UnstableTimeStepMessageGivesTheLimit) {
   EXPECT_NE(problems[0].find(text.str()), std::string::npos) << problems[0];
 }
 
+// Extreme but finite numbers found by fuzzing the shipped scenes: each hung the stability limit's
+// eigenvalue computation or aborted the loading solve; each is now refused, naming the field.
+TEST(InvalidScene, ExtremeStiffnessesAndMassesAreRefusedNamingTheField) {
+  struct Case {
+    const char* scene;
+    const char* field;
+    const char* value;
+    const char* refused;
+  };
+  const Case cases[] = {
+      {"single_block", "material.density", "1e-320", "integrator.time_step: value 1e-06 is not allowed; allowed: none"},
+      {"pmma_2d", "material.youngs_modulus", "1e308",
+       "integrator.time_step: value 2e-07 is not allowed; allowed: none"},
+      {"pmma_2d", "pusher.stiffness", "1e308", "integrator.time_step: value 2e-07 is not allowed; allowed: none"},
+      {"pmma_2d", "lattice.foundation_ratio", "1e300", "integrator.time_step: value 2e-07 is not allowed"},
+      {"pmma_1d_top", "material.youngs_modulus", "1e300", "integrator.time_step: value 2e-07 is not allowed"},
+      {"pmma_2d", "lattice.foundation_ratio", "1e-320",
+       "lattice.foundation_ratio: value 9.999888672e-321 is not allowed"}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.scene) + ", " + c.field + " = " + c.value);
+    try {
+      loadScene(scenePath(c.scene), {{c.field, c.value}});
+      FAIL() << "accepted";
+    } catch (const SceneError& error) {
+      EXPECT_TRUE(mentions(error.problems(), c.refused)) << error.what();
+    }
+  }
+  // The least foundation that carries F_Z by sinking under a tenth of a spacing: 10 F_Z/(N_x k l).
+  const auto problems = problemsOf("lattice: {foundation_ratio: 1.0e-3}");
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_TRUE(mentions(problems, "allowed: >= 0.0099")) << problems[0];
+}
+
 TEST(InvalidScene, EveryProblemOfAFileIsListedAtOnce) {
   const auto problems = problemsOf(
       "geometry: {length: -0.14}\n"

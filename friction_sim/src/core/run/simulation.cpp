@@ -33,7 +33,14 @@ Simulation::Simulation(const Scene& scene, double stability_limit)
       inverse_mass_(1.0 / node_mass_),
       quasi_static_stage_speed_(1e-3 * std::sqrt(scene_.material.youngs_modulus / scene_.material.density)),
       fast_forward_(std::make_unique<FastForward>(*this)) {
-  relaxToLoadedEquilibrium();
+  try {
+    relaxToLoadedEquilibrium();
+  } catch (const std::runtime_error& error) {
+    // A valid scene whose loaded equilibrium cannot be solved is still the scene's problem, not a crash.
+    throw SceneError({std::string("the loading solve failed (") + error.what() +
+                      "): the stiffnesses of the scene (material, lattice, pusher, load) are too far apart to "
+                      "solve in double precision"});
+  }
 }
 
 void Simulation::relaxToLoadedEquilibrium() {

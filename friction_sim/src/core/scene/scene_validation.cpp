@@ -245,10 +245,30 @@ double checkTimeStep(Checker& check, const Scene& s) {
   const double limit = sceneStabilityLimit(s);
   std::ostringstream allowed;
   allowed.precision(4);
-  allowed << "dt < " << limit << " s, the stability limit of this scene for "
-          << (s.integrator.scheme == IntegratorKind::RungeKutta4 ? "rk4" : "velocity_verlet");
+  if (limit > 0.0) {
+    allowed << "dt < " << limit << " s, the stability limit of this scene for "
+            << (s.integrator.scheme == IntegratorKind::RungeKutta4 ? "rk4" : "velocity_verlet");
+  } else {
+    allowed << "none: the scene's stiffest mode has no finite frequency or damping rate, so no time step is "
+               "stable; material.density, material.youngs_modulus, lattice.foundation_ratio, pusher.stiffness "
+               "or friction.interfacial_stiffness is out of any physical range";
+  }
   check.require(s.integrator.time_step < limit, "integrator.time_step", s.integrator.time_step, allowed.str());
   return limit;
+}
+
+/// The foundation's contact springs carry F_Z: with the linear contact model the slider must sink into
+/// the track by a small fraction of a node spacing, or the loading solve is meaningless (and, with k_f
+/// far below the bonds, numerically singular).
+void checkFoundation(Checker& check, const Scene& s) {
+  const double spacing = s.geometry.length / (s.lattice.nodes_x - 1);
+  const double bond_stiffness = 0.75 * s.geometry.width * s.material.youngs_modulus;
+  const double least_ratio = 10.0 * s.load.normal_force / (s.lattice.nodes_x * bond_stiffness * spacing);
+  std::ostringstream allowed;
+  allowed << ">= " << least_ratio << ", so that F_Z sinks the slider into the track by under a tenth of the "
+          << "node spacing (F_Z/(nodes_x*k_f) < " << 0.1 * spacing << " m, k_f = ratio*0.75*B*E)";
+  check.require(s.lattice.foundation_ratio >= least_ratio, "lattice.foundation_ratio", s.lattice.foundation_ratio,
+                allowed.str());
 }
 
 }  // namespace
@@ -287,6 +307,7 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
     return check.problems;
   }
   if (!lattice && check.clean({"friction.static_coefficient"})) checkChainStatics(check, s);
+  if (lattice) checkFoundation(check, s);
   const double limit = checkTimeStep(check, s);
   if (stability_limit) *stability_limit = limit;
   return check.problems;

@@ -124,13 +124,17 @@ double nodeByNodeBound(const SparseMatrix& stiffness, const Vector& anchors, int
 }  // namespace
 
 double stabilityLimit(IntegratorKind kind, double omega_max, double damping_rate) {
+  // A mode of infinite (or undefined) frequency or damping: no step is stable. The eigenvalues of a
+  // non-finite amplification matrix would not converge.
+  if (!std::isfinite(omega_max) || !std::isfinite(damping_rate)) return 0.0;
   if (omega_max <= 0.0) return std::numeric_limits<double>::infinity();
   // Work in units of 1/ω: the amplification matrix then has entries of order one and its eigenvalues
   // are not swamped by round-off.
   const double relative_damping = damping_rate / omega_max;
   auto stable = [&](double dt) { return spectralRadius(kind, 1.0, relative_damping, dt) <= 1.0 + 1e-9; };
+  // Every scheme here is unstable beyond a few periods per step: the growth ends in a few iterations.
   double low = 0.0, high = 1.0;
-  while (stable(high)) {
+  for (int growth = 0; growth < 100 && stable(high); ++growth) {
     low = high;
     high *= 1.5;
   }
