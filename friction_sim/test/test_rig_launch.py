@@ -181,6 +181,24 @@ class RigLaunchStatusTest(unittest.TestCase):
         # Into a pipe: no colour codes, no terminal title.
         self.assertNotIn("\x1b", output)
 
+    def test_a_second_rig_cannot_write_the_bag_a_rig_is_writing(self):
+        work = tempfile.mkdtemp(prefix="rig_launch_test_")
+        self.addCleanup(shutil.rmtree, work)
+        bag = os.path.join(work, "run.bag")
+        with SlowRun("real_time_factor:=0.01", "record:=true", "bag:=" + bag) as first:
+            self.assertIsNotNone(first.simulator, "the simulator did not start")
+            self.assertTrue(os.path.exists(bag + ".active"))  # written under a temporary name
+            self.assertFalse(os.path.exists(bag))
+            self.assert_launch_fails(["record:=true", "bag:=" + bag],
+                                     "~bag: value '%s' is being written by another rig" % bag,
+                                     "rig_launch: failed: rig_simulator (exit code 2)")
+            first.process.send_signal(signal.SIGTERM)
+            status, output = first.finish()
+        self.assertEqual(status, 130, output)
+        # Closed, it has its own name.
+        self.assertTrue(os.path.exists(bag), output)
+        self.assertFalse(os.path.exists(bag + ".active"))
+
     def test_a_simulator_told_to_wait_for_subscribers_that_never_come_fails_naming_them(self):
         self.assert_launch_fails(["scene:=" + SINGLE_BLOCK, "controller:=false", "wait_for_subscribers:=load_cells",
                                   "subscriber_timeout:=1"],

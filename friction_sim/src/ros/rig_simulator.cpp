@@ -4,8 +4,15 @@
 #include <std_msgs/String.h>
 #include <boost/make_shared.hpp>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -148,23 +155,52 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
   wave_speeds_ = waveSpeeds(scene_);
   // Opened before the run starts: a bag that cannot be written is refused rather than found out after
   // the loading solve, or lost at the end.
-  if (!options_.bag_path.empty()) {
-    try {
-      bag_.open(options_.bag_path, rosbag::bagmode::Write);
-      bag_.setCompression(*bagCompression(options_.bag_compression));
-    } catch (const rosbag::BagException& error) {
-      throw ConfigError("parameters of " + ros::this_node::getName(),
-                        {"~bag: value '" + options_.bag_path + "' cannot be written (" + error.what() +
-                         "); allowed: a file path in a writable directory"});
-    }
-    bag_open_ = true;
-  }
+  if (!options_.bag_path.empty()) openBag();
   startSimulation();
   advertise();
 }
 
-RigSimulator::~RigSimulator() {
-  if (bag_open_) bag_.close();
+RigSimulator::~RigSimulator() { closeBag(); }
+
+void RigSimulator::openBag() {
+  // As rosbag record does, the bag is written as BAG.active and renamed when closed: a bag under its
+  // own name is complete. The lock on BAG.active keeps a second rig from writing the same bag.
+  const std::string active = options_.bag_path + ".active";
+  auto refuse = [&](const std::string& why) {
+    if (bag_lock_ >= 0) ::close(bag_lock_);
+    bag_lock_ = -1;
+    throw ConfigError("parameters of " + ros::this_node::getName(), {"~bag: value '" + options_.bag_path + "' " + why});
+  };
+  bag_lock_ = ::open(active.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (bag_lock_ < 0) {
+    refuse(std::string("cannot be written (") + std::strerror(errno) +
+           "); allowed: a file path in a writable directory");
+  }
+  if (::flock(bag_lock_, LOCK_EX | LOCK_NB) != 0) {
+    refuse("is being written by another rig (" + active + " is locked); allowed: a bag path no running rig writes");
+  }
+  try {
+    bag_.open(active, rosbag::bagmode::Write);
+    bag_.setCompression(*bagCompression(options_.bag_compression));
+  } catch (const rosbag::BagException& error) {
+    refuse(std::string("cannot be written (") + error.what() + "); allowed: a file path in a writable directory");
+  }
+  bag_open_ = true;
+}
+
+void RigSimulator::closeBag() {
+  if (bag_open_) {
+    bag_.close();
+    bag_open_ = false;
+    const std::string active = options_.bag_path + ".active";
+    if (std::rename(active.c_str(), options_.bag_path.c_str()) != 0) {
+      ROS_ERROR_STREAM("the bag stays at " << active << ": it could not be renamed (" << std::strerror(errno) << ")");
+    }
+  }
+  if (bag_lock_ >= 0) {
+    ::close(bag_lock_);
+    bag_lock_ = -1;
+  }
 }
 
 void RigSimulator::startSimulation() {
@@ -496,8 +532,7 @@ void RigSimulator::finish(const std::string& end_reason) {
   printSummary(std::cout, summary);
   if (resets_ > 0) std::cout << "  (the run since the last of " << resets_ << " reset(s))" << std::endl;
   if (bag_open_) {
-    bag_.close();
-    bag_open_ = false;
+    closeBag();
     std::cout << "  bag written to " << options_.bag_path << std::endl;
   }
   // roscpp sends from its own thread: a node that exits at once can drop what it published last (the

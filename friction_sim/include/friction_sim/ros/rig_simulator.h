@@ -12,7 +12,9 @@
 //   clock_rate (double, 1e4)        Hz of simulated time, /clock
 //   lattice_rate (double, 200)      Hz of simulated time, lattice snapshots (also written to the bag)
 //   snapshot_rate (double, 20)      Hz of wall time, extra lattice snapshots while someone watches live
-//   bag (string, "")                write every instrument topic to this bag, independent of subscribers
+//   bag (string, "")                write every instrument topic to this bag, independent of subscribers;
+//                                   written as BAG.active (locked: a second rig is refused) and renamed
+//                                   when closed, as rosbag record does
 //   bag_compression (string, "lz4") the bag's chunks: "lz4", "bz2" or "none" (docs/ros_api.md: sizes)
 //   frame_id (string, "slider")     frame of every message
 //   stop_at_scene_end (bool, true)  end when the scene's stop condition holds
@@ -155,6 +157,10 @@ class RigSimulator {
   /// The stage state, the summary and the bag at the end of the run.
   void finish(const std::string& end_reason);
   void advertise();
+  /// Opens ~bag as BAG.active, locked against a second writer; throws ConfigError if it cannot.
+  void openBag();
+  /// Closes the bag and renames it to its own name, then drops the lock.
+  void closeBag();
   void startSimulation();
   /// The scene as it runs now (its stop condition set_run_end's, if called) on `scene` and in the bag.
   void publishScene();
@@ -195,6 +201,7 @@ class RigSimulator {
   WaveSpeeds wave_speeds_;
   rosbag::Bag bag_;
   bool bag_open_ = false;
+  int bag_lock_ = -1;  ///< descriptor holding the flock on BAG.active while this rig writes the bag
   bool paused_ = false;
   bool stop_ = false;
   bool aborted_ = false;
