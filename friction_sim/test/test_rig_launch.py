@@ -93,6 +93,21 @@ def launch(*args, cwd=None, env=None, launch_file=(RIG,)):
     return done.returncode, done.stdout + done.stderr
 
 
+# Publishes 5000 commands on the rig's topic as fast as it can, once the simulator listens (waits in
+# wall time: the rig's clock runs at a hundredth of it).
+FLOOD = """
+import time
+import rospy
+from friction_msgs.msg import StageCommand
+rospy.init_node("flood", anonymous=True)
+publisher = rospy.Publisher("/rig/stage_command", StageCommand, queue_size=100000)
+while publisher.get_num_connections() == 0:
+    time.sleep(0.05)
+for _ in range(5000):
+    publisher.publish(StageCommand(mode=StageCommand.HOLD))
+time.sleep(5.0)
+"""
+
 USERS_LAUNCH = """<launch>
   <include file="$(find friction_sim)/launch/rig.launch">
     <arg name="scene" value="%s"/>
@@ -198,6 +213,24 @@ class RigLaunchStatusTest(unittest.TestCase):
         # Closed, it has its own name.
         self.assertTrue(os.path.exists(bag), output)
         self.assertFalse(os.path.exists(bag + ".active"))
+
+    def test_commands_a_full_queue_drops_are_counted_and_reported(self):
+        # Paced at a hundredth of real time, the simulator sleeps across its fast-forward jumps: 5000
+        # commands sent at once overflow its queue of 1000.
+        with SlowRun() as run:
+            self.assertIsNotNone(run.simulator, "the simulator did not start")
+            master = re.search(r"private master at (\S+);", run.lines[0]).group(1)
+            env = dict(os.environ, ROS_MASTER_URI=master)
+            subprocess.run(["/usr/bin/python3", "-c", FLOOD], env=env, timeout=120, check=True)
+            state = subprocess.run(["rostopic", "echo", "-n", "1", "/rig/stage_state/commands_dropped"],
+                                   capture_output=True, text=True, timeout=60, env=env)
+            run.process.send_signal(signal.SIGTERM)
+            status, output = run.finish()
+        dropped = int(state.stdout.split()[0])
+        self.assertGreater(dropped, 0, output)
+        self.assertLess(dropped, 5000)
+        self.assertRegex(output, r"command\(s\) from /flood_\w+ on /rig/stage_command were dropped unread: the "
+                                 r"queue of 1000 was full \(%d so far\)" % dropped)
 
     def test_a_simulator_told_to_wait_for_subscribers_that_never_come_fails_naming_them(self):
         self.assert_launch_fails(["scene:=" + SINGLE_BLOCK, "controller:=false", "wait_for_subscribers:=load_cells",

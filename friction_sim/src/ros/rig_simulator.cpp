@@ -27,6 +27,9 @@ namespace friction {
 std::atomic<bool> g_stop_requested{false};
 
 namespace {
+/// stage_command's subscriber queue: commands beyond it, unread, are dropped (and counted).
+constexpr std::uint32_t kCommandQueue = 1000;
+
 /// The compression named by ~bag_compression, or none if the name is unknown.
 std::optional<rosbag::compression::CompressionType> bagCompression(const std::string& name) {
   if (name == "lz4") return rosbag::compression::LZ4;
@@ -260,7 +263,7 @@ void RigSimulator::advertise() {
   lattice_pub_ = nh_.advertise<friction_msgs::LatticeSnapshot>("lattice", 2);
   stage_pub_ = nh_.advertise<friction_msgs::StageState>("stage_state", 100);
   applied_commands_pub_ = nh_.advertise<friction_msgs::StageCommand>("applied_commands", 100);
-  command_sub_ = nh_.subscribe("stage_command", 1000, &RigSimulator::onCommand, this);
+  command_sub_ = nh_.subscribe("stage_command", kCommandQueue, &RigSimulator::onCommand, this);
   command_srv_ = nh_.advertiseService("send_command", &RigSimulator::onSendCommand, this);
   pause_srv_ = nh_.advertiseService("pause", &RigSimulator::onPause, this);
   reset_srv_ = nh_.advertiseService("reset", &RigSimulator::onReset, this);
@@ -326,6 +329,7 @@ void RigSimulator::publishStageState(const StageStateReading& reading) {
   msg.global_events = simulation().globalEventCount();
   msg.paused = paused_;
   msg.resets = resets_;
+  msg.commands_dropped = commands_dropped_;
   emit(stage_pub_, "stage_state", msg);
 }
 
@@ -368,7 +372,22 @@ void RigSimulator::publishAppliedCommand(const TimedCommand& command, const std:
   if (bag_open_) bag_.write(applied_commands_pub_.getTopic(), std::max(applied.header.stamp, ros::Time(0, 2)), applied);
 }
 
-void RigSimulator::onCommand(const friction_msgs::StageCommand::ConstPtr& msg) { accept(*msg); }
+void RigSimulator::onCommand(const ros::MessageEvent<const friction_msgs::StageCommand>& event) {
+  // roscpp numbers every message a publisher sends (header.seq): a gap is messages that a full queue
+  // dropped, here or in the publisher, before this callback saw them.
+  const std::uint32_t seq = event.getMessage()->header.seq;
+  const auto last = last_command_seq_.find(event.getPublisherName());
+  if (last != last_command_seq_.end() && seq > last->second + 1) {
+    const std::uint32_t dropped = seq - last->second - 1;
+    commands_dropped_ += dropped;
+    ROS_WARN_STREAM(dropped << " command(s) from " << event.getPublisherName() << " on " << command_sub_.getTopic()
+                            << " were dropped unread: the queue of " << kCommandQueue << " was full ("
+                            << commands_dropped_
+                            << " so far); send them slower, or call send_command, which answers each");
+  }
+  last_command_seq_[event.getPublisherName()] = seq;
+  accept(*event.getMessage());
+}
 
 bool RigSimulator::onSendCommand(friction_msgs::SendStageCommand::Request& request,
                                  friction_msgs::SendStageCommand::Response& response) {

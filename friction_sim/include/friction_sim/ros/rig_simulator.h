@@ -50,7 +50,10 @@
 // sees the slider move and a command sent "now" acts within a frame; and while the stage rests with no
 // end in sight (nothing due, no program segment to end), whose jumps would have no end.
 // Subscribed topics:
-//   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time)
+//   stage_command (friction_msgs/StageCommand)     applied at header.stamp (simulated time); commands lost
+//                                                  to a full queue (1000) are counted from the gaps in each
+//                                                  publisher's header.seq, logged, and reported in
+//                                                  stage_state.commands_dropped
 // Services:
 //   send_command (friction_msgs/SendStageCommand)  the same, with the verdict in the reply
 //   set_run_end (friction_msgs/SetRunEnd)         ends the run at the first step where a count of global
@@ -85,6 +88,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -174,7 +178,7 @@ class RigSimulator {
   void publishStageState();
   void publishAppliedCommand(const TimedCommand& command, const std::string& refusal);
   std::string accept(const friction_msgs::StageCommand& msg);
-  void onCommand(const friction_msgs::StageCommand::ConstPtr& msg);
+  void onCommand(const ros::MessageEvent<const friction_msgs::StageCommand>& event);
   bool onSendCommand(friction_msgs::SendStageCommand::Request& request,
                      friction_msgs::SendStageCommand::Response& response);
   bool onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
@@ -211,6 +215,8 @@ class RigSimulator {
   int scenes_recorded_ = 0;   ///< scene messages written to the bag
   std::uint32_t resets_ = 0;  ///< resets so far, in stage_state: a controller cannot always tell one by the time
   std::uint32_t frame_index_ = 0;
+  std::map<std::string, std::uint32_t> last_command_seq_;  ///< per publisher of stage_command, its last header.seq
+  std::uint32_t commands_dropped_ = 0;                     ///< stage_command messages lost to a full queue
   ros::WallTime next_snapshot_, pace_origin_wall_;
   double running_wall_time_ = 0.0;  ///< s, wall time spent running before running_since_
   ros::WallTime running_since_;     ///< when the simulation last began running (unpaused)
