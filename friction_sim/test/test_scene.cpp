@@ -2,6 +2,8 @@
 // the value and what is allowed, and a file with several problems lists them all.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -243,6 +245,25 @@ TEST(InvalidScene, ExtremeStiffnessesAndMassesAreRefusedNamingTheField) {
   const auto problems = problemsOf("lattice: {foundation_ratio: 1.0e-3}");
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_TRUE(mentions(problems, "allowed: >= 0.0099")) << problems[0];
+}
+
+// A scene too large for the machine is refused before anything is allocated, naming the field that
+// sizes it (a 10^8 x 5·10^7 lattice once grew to 19 GB before failing).
+TEST(InvalidScene, AScenePastTheMemoryLimitIsRefusedBeforeItIsBuilt) {
+  try {
+    loadScene(scenePath("pmma_2d"), {{"lattice.nodes_x", "100000001"}, {"lattice.nodes_z", "53571429"}});
+    FAIL() << "accepted";
+  } catch (const SceneError& error) {
+    EXPECT_TRUE(mentions(error.problems(), "lattice.nodes_x: value 100000001 is not allowed; allowed: at most"))
+        << error.what();
+  }
+  // The limit can be set: 100 MB holds 57 x 31 (5.3 MB for its nodes) but not 449 x 241 (325 MB).
+  setenv("FRICTION_MEMORY_LIMIT_MB", "100", 1);
+  EXPECT_TRUE(problemsOf("lattice: {nodes_x: 57, nodes_z: 31}").empty());
+  const auto problems = problemsOf("lattice: {nodes_x: 449, nodes_z: 241}\nintegrator: {time_step: 1.0e-8}");
+  unsetenv("FRICTION_MEMORY_LIMIT_MB");
+  EXPECT_TRUE(mentions(problems, "lattice.nodes_x: value 449 is not allowed; allowed: at most 33333 nodes"))
+      << problems[0];
 }
 
 TEST(InvalidScene, EveryProblemOfAFileIsListedAtOnce) {
