@@ -108,6 +108,13 @@ class LaunchFilesTest(unittest.TestCase):
         self.assertEqual(config.params["/rig/simulator/wait_for_subscribers"].value, "load_cells interface:2")
         self.assertEqual(config.params["/rig/simulator/subscriber_timeout"].value, 5)
 
+    def test_publish_rates_are_launch_arguments_and_the_simulators_defaults_stay_otherwise(self):
+        self.assertEqual(load("rig.launch", "load_cell_rate:=1000", "lattice_rate:=20").params[
+            "/rig/simulator/load_cell_rate"].value, 1000)
+        config = load("rig.launch")
+        self.assertNotIn("/rig/simulator/load_cell_rate", config.params)
+        self.assertNotIn("/rig/simulator/lattice_rate", config.params)
+
     def test_the_rig_runs_on_this_machine_by_default(self):
         config = load("rig.launch")
         self.assertEqual(host(config, "simulator"), "")
