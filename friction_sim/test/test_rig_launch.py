@@ -4,6 +4,7 @@ crashes, so the script reads the nodes' exit codes and fails, naming the node; a
 exits 0, an interrupted one 130 after every node has stopped. Each launch brings up its own private
 master on a free port. It keeps the caller's packages (a launch file of their own, by package name,
 with a node of their own) and writes no terminal codes into a pipe."""
+import json
 import os
 import re
 import shutil
@@ -93,9 +94,11 @@ def launch(*args, cwd=None, env=None, launch_file=(RIG,)):
     return done.returncode, done.stdout + done.stderr
 
 
-# Publishes 5000 commands on the rig's topic as fast as it can, once the simulator listens (waits in
-# wall time: the rig's clock runs at a hundredth of it).
+# Publishes 5000 commands on the rig's topic as fast as it can once told to (a line on its input), after
+# saying that the simulator listens; then gives them 5 s to drain (waits in wall time: the rig's clock
+# runs at a hundredth of it).
 FLOOD = """
+import sys
 import time
 import rospy
 from friction_msgs.msg import StageCommand
@@ -103,9 +106,37 @@ rospy.init_node("flood", anonymous=True)
 publisher = rospy.Publisher("/rig/stage_command", StageCommand, queue_size=100000)
 while publisher.get_num_connections() == 0:
     time.sleep(0.05)
+print("connected", flush=True)
+sys.stdin.readline()
 for _ in range(5000):
     publisher.publish(StageCommand(mode=StageCommand.HOLD))
+print("sent", flush=True)
 time.sleep(5.0)
+"""
+
+# For 4 s of wall time: when each load-cell message arrives, and how long the pause service takes to
+# answer (asked to keep running), printed as JSON.
+PACING = """
+import json
+import time
+import rospy
+from geometry_msgs.msg import WrenchStamped
+from std_srvs.srv import SetBool
+rospy.init_node("pacing", anonymous=True)
+arrivals = []
+rospy.Subscriber("/rig/load_cells", WrenchStamped, lambda _: arrivals.append(time.time()), queue_size=100000)
+rospy.wait_for_service("/rig/pause", timeout=60)
+keep_running = rospy.ServiceProxy("/rig/pause", SetBool)
+time.sleep(1.0)
+start = time.time()
+del arrivals[:]
+latencies = []
+while time.time() - start < 4.0:
+    asked = time.time()
+    keep_running(False)
+    latencies.append(time.time() - asked)
+    time.sleep(0.2)
+print(json.dumps({"start": start, "arrivals": list(arrivals), "latencies": latencies}))
 """
 
 USERS_LAUNCH = """<launch>
@@ -215,13 +246,22 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertFalse(os.path.exists(bag + ".active"))
 
     def test_commands_a_full_queue_drops_are_counted_and_reported(self):
-        # Paced at a hundredth of real time, the simulator sleeps across its fast-forward jumps: 5000
-        # commands sent at once overflow its queue of 1000.
+        # 5000 commands reach a simulator held stopped (SIGSTOP): once it goes on, its network thread
+        # queues them faster than it reads them, and its queue of 1000 overflows.
         with SlowRun() as run:
             self.assertIsNotNone(run.simulator, "the simulator did not start")
             master = re.search(r"private master at (\S+);", run.lines[0]).group(1)
             env = dict(os.environ, ROS_MASTER_URI=master)
-            subprocess.run(["/usr/bin/python3", "-c", FLOOD], env=env, timeout=120, check=True)
+            flood = subprocess.Popen(["/usr/bin/python3", "-c", FLOOD], env=env, stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, text=True)
+            self.assertEqual(flood.stdout.readline().strip(), "connected")
+            os.kill(run.simulator, signal.SIGSTOP)
+            flood.stdin.write("go\n")
+            flood.stdin.flush()
+            self.assertEqual(flood.stdout.readline().strip(), "sent")
+            threading.Event().wait(1.0)
+            os.kill(run.simulator, signal.SIGCONT)
+            flood.communicate(timeout=60)
             state = subprocess.run(["rostopic", "echo", "-n", "1", "/rig/stage_state/commands_dropped"],
                                    capture_output=True, text=True, timeout=60, env=env)
             run.process.send_signal(signal.SIGTERM)
@@ -231,6 +271,25 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertLess(dropped, 5000)
         self.assertRegex(output, r"command\(s\) from /flood_\w+ on /rig/stage_command were dropped unread: the "
                                  r"queue of 1000 was full \(%d so far\)" % dropped)
+
+    def test_a_paced_run_publishes_evenly_and_answers_services_at_once(self):
+        # At a hundredth of real time the load cells' 10 kHz of simulated time is 100 Hz of wall time;
+        # the run fast-forwards in jumps of 10 ms (a second of wall time), which came out in bursts.
+        with SlowRun() as run:
+            self.assertIsNotNone(run.simulator, "the simulator did not start")
+            master = re.search(r"private master at (\S+);", run.lines[0]).group(1)
+            measured = subprocess.run(["/usr/bin/python3", "-c", PACING], capture_output=True, text=True, timeout=120,
+                                      env=dict(os.environ, ROS_MASTER_URI=master))
+            run.process.send_signal(signal.SIGTERM)
+            run.finish()
+        self.assertEqual(measured.returncode, 0, measured.stderr)
+        seen = json.loads(measured.stdout.strip().splitlines()[-1])
+        # Each half second holds 50 messages, within 20 %.
+        counts = [sum(1 for t in seen["arrivals"] if seen["start"] + 0.5 * k <= t < seen["start"] + 0.5 * (k + 1))
+                  for k in range(8)]
+        for count in counts:
+            self.assertTrue(40 <= count <= 60, counts)
+        self.assertLess(max(seen["latencies"]), 0.2, seen["latencies"])
 
     def test_a_simulator_told_to_wait_for_subscribers_that_never_come_fails_naming_them(self):
         self.assert_launch_fails(["scene:=" + SINGLE_BLOCK, "controller:=false", "wait_for_subscribers:=load_cells",

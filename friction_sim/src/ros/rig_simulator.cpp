@@ -29,6 +29,7 @@ std::atomic<bool> g_stop_requested{false};
 namespace {
 /// stage_command's subscriber queue: commands beyond it, unread, are dropped (and counted).
 constexpr std::uint32_t kCommandQueue = 1000;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 /// The compression named by ~bag_compression, or none if the name is unknown.
 std::optional<rosbag::compression::CompressionType> bagCompression(const std::string& name) {
@@ -228,7 +229,7 @@ void RigSimulator::addStreams(RunDriver& driver) {
   const SimulatorOptions& o = options_;
   driver.add(std::make_unique<SampledStream<Instant>>(
       o.clock_rate, Sampling::AtSteps, [](const Simulation& s) { return Instant{s.time()}; },
-      [this](const Instant& instant) { publishClock(instant.time); }));
+      [this](const Instant& instant) { publishPaced(instant.time, [this, instant] { publishClock(instant.time); }); }));
   driver.add(std::make_unique<SampledStream<LoadCellReading>>(
       o.load_cell_rate, Sampling::AtSteps, [](const Simulation& s) { return s.loadCells(); },
       [this](const LoadCellReading& cells) { emit(load_cells_pub_, "load_cells", toMsg(cells, options_.frame_id)); },
@@ -298,7 +299,7 @@ void RigSimulator::publishScene() {
 
 template <class Message>
 void RigSimulator::emit(ros::Publisher& publisher, const std::string& topic, const Message& msg) {
-  publisher.publish(msg);
+  publishPaced(msg.header.stamp.toSec(), [&publisher, msg] { publisher.publish(msg); });
   // Before the first step (t = 0, e.g. the stage state while waiting paused) nothing was measured, and
   // a bag cannot hold a zero stamp.
   if (bag_open_ && !msg.header.stamp.isZero())
@@ -406,8 +407,10 @@ bool RigSimulator::onPause(std_srvs::SetBool::Request& request, std_srvs::SetBoo
 void RigSimulator::setPaused(bool paused) {
   const ros::WallTime now = ros::WallTime::now();
   if (paused && !paused_) running_wall_time_ += (now - running_since_).toSec();
-  if (!paused && paused_) running_since_ = now;
-  if (!paused) {
+  // Only on resuming: asked to run while running, the pace keeps its origin (moving it to the
+  // simulation's time, which runs ahead of the wall clock, skipped the messages held for it).
+  if (!paused && paused_) {
+    running_since_ = now;
     pace_origin_wall_ = now;
     pace_origin_sim_ = simulation().time();
   }
@@ -454,11 +457,41 @@ bool RigSimulator::onSetRunEnd(friction_msgs::SetRunEnd::Request& request,
   return true;
 }
 
+void RigSimulator::publishPaced(double time, std::function<void()> publish) {
+  if (options_.real_time_factor <= 0.0) {
+    publish();
+    return;
+  }
+  // Held with the rest, so that messages go out in the order of their times.
+  paced_.emplace(time, std::move(publish));
+  releasePaced(pacedTime());
+}
+
+double RigSimulator::pacedTime() const {
+  return pace_origin_sim_ + (ros::WallTime::now() - pace_origin_wall_).toSec() * options_.real_time_factor;
+}
+
+void RigSimulator::releasePaced(double until) {
+  while (!paced_.empty() && paced_.begin()->first <= until) {
+    // Out of the queue before it runs: publishing may hold another message.
+    const std::function<void()> publish = std::move(paced_.begin()->second);
+    paced_.erase(paced_.begin());
+    publish();
+  }
+}
+
 void RigSimulator::pace() {
   if (options_.real_time_factor <= 0.0) return;
-  const double ahead = (simulation().time() - pace_origin_sim_) / options_.real_time_factor -
-                       (ros::WallTime::now() - pace_origin_wall_).toSec();
-  if (ahead > 1e-3) ros::WallDuration(ahead).sleep();
+  // A step or a jump computes ahead of the wall clock: its messages go out as their simulated times come
+  // due, not in a burst, and services and commands are answered meanwhile.
+  constexpr double kSlice = 0.01;  // s of wall time between releases and spins
+  while (!paused_ && !stop_ && !reset_requested_ && !g_stop_requested && ros::ok()) {
+    releasePaced(pacedTime());
+    const double ahead = (simulation().time() - pacedTime()) / options_.real_time_factor;
+    if (ahead <= 1e-3) return;
+    ros::WallDuration(std::min(ahead, kSlice)).sleep();
+    ros::spinOnce();
+  }
 }
 
 void RigSimulator::run() {
@@ -512,6 +545,7 @@ std::string RigSimulator::runUntilTheEnd() {
       next_spin = now + ros::WallDuration(0.002);
     }
     if (reset_requested_) {
+      releasePaced(kInfinity);  // the old run's last messages, before the new run's
       ++resets_;
       startSimulation();
       publishScene();  // the scene's own run end again
@@ -544,6 +578,7 @@ std::string RigSimulator::runUntilTheEnd() {
 void RigSimulator::finish(const std::string& end_reason) {
   driver_->finishRun();
   publishStageState();
+  releasePaced(kInfinity);
   // The summary is the run since the last reset: its simulated time and steps start there, and its wall
   // time is the time spent running since, not waiting paused (for a controller, or a user).
   RunSummary summary = summarize(simulation(), runningWallTime());

@@ -88,6 +88,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -186,7 +187,15 @@ class RigSimulator {
   bool onStop(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onAbort(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onSetRunEnd(friction_msgs::SetRunEnd::Request& request, friction_msgs::SetRunEnd::Response& response);
+  /// Sleeps until the wall clock reaches the simulation's time (paced runs), releasing the messages
+  /// held for their times and answering services every 10 ms.
   void pace();
+  /// Publishes now, or, in a paced run, when the wall clock reaches simulated time `time` (s).
+  void publishPaced(double time, std::function<void()> publish);
+  /// s, the simulated time the wall clock has reached in a paced run.
+  double pacedTime() const;
+  /// Publishes the held messages due by simulated time `until` (s), in time order.
+  void releasePaced(double until);
   /// Pauses or runs the simulation, keeping the pace's origin and the wall time spent running.
   void setPaused(bool paused);
   /// s of wall time spent running (not paused) since the simulation last started.
@@ -221,6 +230,7 @@ class RigSimulator {
   double running_wall_time_ = 0.0;  ///< s, wall time spent running before running_since_
   ros::WallTime running_since_;     ///< when the simulation last began running (unpaused)
   double pace_origin_sim_ = 0.0;
+  std::multimap<double, std::function<void()>> paced_;  ///< messages held for their simulated times (s)
   ros::Publisher clock_pub_, load_cells_pub_, gauges_pub_, interface_pub_, events_pub_, lattice_pub_, stage_pub_,
       scene_pub_, applied_commands_pub_;
   ros::Subscriber command_sub_;
