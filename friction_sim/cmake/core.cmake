@@ -6,6 +6,8 @@ find_package(yaml-cpp REQUIRED)
 # large lattices within memory (Eigen's simplicial LDLT needed > 3 GB at 10^6 nodes).
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
 find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+# Eigen's and CHOLMOD's headers for every target from here on (the public static_solver.h includes both).
+include_directories(SYSTEM ${EIGEN3_INCLUDE_DIR} ${CHOLMOD_INCLUDE_DIR})
 
 add_library(friction_sim_core
   src/core/contact/contact_interface.cpp
@@ -36,7 +38,6 @@ add_library(friction_sim_core
 )
 # Public headers in include/friction_sim/<room>/, the core's own next to its sources (src/core/<room>/).
 target_include_directories(friction_sim_core PUBLIC include PRIVATE src/core)
-target_include_directories(friction_sim_core SYSTEM PUBLIC ${EIGEN3_INCLUDE_DIR} ${CHOLMOD_INCLUDE_DIR})
 # errno from sqrt is never read: without it the bond loops vectorise. No FMA contraction: a vector
 # loop's peeled and main parts would otherwise round differently depending on where a buffer happens
 # to be aligned, and two runs of one scene would drift apart (determinism is tested). No semantic
