@@ -450,6 +450,7 @@ TEST(RateStateHardCases, CoarseTimeStepAndCriticalStiffnessStayBounded) {
   // limit the slip's ringing never dies down: the block slides on, bounded, and never re-sticks.)
   Scene at_limit = loadScene(testing::scenePath("rate_state"));
   at_limit.integrator.time_step = 0.5 * sceneStabilityLimit(at_limit);
+  at_limit.instruments.loading_curve_rate = 1.0 / at_limit.integrator.time_step;  // a sample a step at most
   Simulation coarse(at_limit);
   coarse.run();
   ASSERT_EQ(coarse.events().size(), 3u);

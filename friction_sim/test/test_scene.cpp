@@ -282,13 +282,14 @@ TEST(InvalidScene, EveryProblemOfAFileIsListedAtOnce) {
 }
 
 TEST(InvalidScene, ATimeStepBehindAModelProblemIsAnnouncedAndCheckedOnceTheModelIsValid) {
-  const auto problems = problemsOf("material: {density: -1200}\nintegrator: {time_step: 1.0e-3}\n");
+  const auto problems = problemsOf(
+      "material: {density: -1200}\ninstruments: {loading_curve_rate: 100}\nintegrator: {time_step: 1.0e-3}\n");
   ASSERT_EQ(problems.size(), 2u);
   EXPECT_NE(problems[0].find("material.density: value -1200"), std::string::npos) << problems[0];
   EXPECT_NE(problems[1].find("integrator.time_step: value 0.001 not yet checked against the stability limit"),
             std::string::npos)
       << problems[1];
-  const auto fixed = problemsOf("integrator: {time_step: 1.0e-3}\n");
+  const auto fixed = problemsOf("instruments: {loading_curve_rate: 100}\nintegrator: {time_step: 1.0e-3}\n");
   ASSERT_EQ(fixed.size(), 1u);
   EXPECT_NE(fixed[0].find("integrator.time_step: value 0.001 is not allowed; allowed: dt <"), std::string::npos)
       << fixed[0];

@@ -198,6 +198,14 @@ void checkInstrumentsStopAndIntegrator(Checker& check, const Scene& s) {
   check.require(s.stop.stage_travel > 0.0, "stop.stage_travel", s.stop.stage_travel, "a travel > 0 m (.inf allowed)");
   if (!endsTheRun(s.stop)) check.problems.push_back(std::string("stop: ") + kNoEndProblem);
   check.positive("integrator.time_step", s.integrator.time_step);
+  if (s.integrator.time_step > 0.0) {
+    // Samples between steps only interpolate: beyond one a step they resolve nothing and, across a
+    // fast-forward jump, fill the memory.
+    std::ostringstream allowed;
+    allowed << "at most one sample per time step, 1/integrator.time_step = " << 1.0 / s.integrator.time_step << " Hz";
+    check.require(s.instruments.loading_curve_rate <= 1.0 / s.integrator.time_step, "instruments.loading_curve_rate",
+                  s.instruments.loading_curve_rate, allowed.str());
+  }
   if (s.integrator.fast_forward) {
     check.require(s.friction.interfacial_stiffness == 0.0, "friction.interfacial_stiffness",
                   s.friction.interfacial_stiffness, "0 (rigid sticking) when integrator.fast_forward is true");
@@ -257,6 +265,16 @@ double checkTimeStep(Checker& check, const Scene& s) {
                "or friction.interfacial_stiffness is out of any physical range";
   }
   check.require(s.integrator.time_step < limit, "integrator.time_step", s.integrator.time_step, allowed.str());
+  // Ten million steps to the stiffest mode's period resolve nothing more, and a run would not end.
+  constexpr double kFinestShare = 1e-7;
+  if (std::isfinite(limit) && limit > 0.0) {
+    std::ostringstream finest;
+    finest.precision(4);
+    finest << "dt >= " << kFinestShare * limit << " s, 1e-7 of the stability limit: a finer step resolves nothing "
+           << "more and the run would not end";
+    check.require(s.integrator.time_step >= kFinestShare * limit, "integrator.time_step", s.integrator.time_step,
+                  finest.str());
+  }
   return limit;
 }
 
