@@ -181,7 +181,7 @@ def sections(data):
     # The prestress τ/σ at the event's onset where the front ran fast (the three nodes before it turned) and
     # where it ran slow.
     prestress = onset_prestress("rate_state_normal_load", DEFAULT_RUN)
-    spacing = 0.140 / (int(_SCENE["lattice"]["nodes_x"]) - 1)
+    spacing = float(_SCENE["geometry"]["length"]) / (int(_SCENE["lattice"]["nodes_x"]) - 1)
     rows = [(i, t, mean_ratio(prestress.get(i, []), t[0] - 3 * spacing, t[0]),
              mean_ratio(prestress.get(i, []), t[0], t[0] + t[1] + 0.5 * spacing)) for i, t in transitions]
     lower = sum(1 for _, _, fast, slow in rows if slow < fast)

@@ -88,6 +88,11 @@ class SlowRun:
             self.process.wait()
 
 
+def master_uri(first_line):
+    """The private master's address, from the first line rig_launch.sh prints."""
+    return re.search(r"private master at (\S+);", first_line).group(1)
+
+
 def launch(*args, cwd=None, env=None, launch_file=(RIG,)):
     done = subprocess.run([RIG_LAUNCH] + list(launch_file) + list(args), capture_output=True, text=True, timeout=120,
                           cwd=cwd, env=env)
@@ -250,7 +255,7 @@ class RigLaunchStatusTest(unittest.TestCase):
         # queues them faster than it reads them, and its queue of 1000 overflows.
         with SlowRun() as run:
             self.assertIsNotNone(run.simulator, "the simulator did not start")
-            master = re.search(r"private master at (\S+);", run.lines[0]).group(1)
+            master = master_uri(run.lines[0])
             env = dict(os.environ, ROS_MASTER_URI=master)
             flood = subprocess.Popen(["/usr/bin/python3", "-c", FLOOD], env=env, stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, text=True)
@@ -277,7 +282,7 @@ class RigLaunchStatusTest(unittest.TestCase):
         # the run fast-forwards in jumps of 10 ms (a second of wall time), which came out in bursts.
         with SlowRun() as run:
             self.assertIsNotNone(run.simulator, "the simulator did not start")
-            master = re.search(r"private master at (\S+);", run.lines[0]).group(1)
+            master = master_uri(run.lines[0])
             measured = subprocess.run(["/usr/bin/python3", "-c", PACING], capture_output=True, text=True, timeout=120,
                                       env=dict(os.environ, ROS_MASTER_URI=master))
             run.process.send_signal(signal.SIGTERM)
@@ -306,7 +311,7 @@ class RigLaunchStatusTest(unittest.TestCase):
                                     "wait_for_subscribers:=interface"], stdout=subprocess.PIPE,
                                    stderr=subprocess.STDOUT, text=True)
         self.addCleanup(lambda: process.poll() is None and process.kill())
-        master = re.search(r"private master at (\S+);", process.stdout.readline()).group(1)
+        master = master_uri(process.stdout.readline())
         threading.Event().wait(3.0)  # the rig is up and waits; a recorder started late
         seen = subprocess.run(["rostopic", "echo", "-n", "1", "/rig/interface/frame_index"], capture_output=True,
                               text=True, timeout=60, env=dict(os.environ, ROS_MASTER_URI=master))

@@ -17,6 +17,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include "friction_sim/instruments/results_io.h"
 #include "friction_sim/ros/node_parameters.h"
@@ -53,6 +54,13 @@ const std::vector<std::pair<std::string, ros::Publisher RigSimulator::*>>& RigSi
   return publishers;
 }
 
+ros::Publisher RigSimulator::*RigSimulator::publisherNamed(const std::string& topic) {
+  for (const auto& [name, member] : waitablePublishers()) {
+    if (name == topic) return member;
+  }
+  throw std::invalid_argument("no waitable topic " + topic);
+}
+
 std::vector<std::string> RigSimulator::waitableTopics() {
   std::vector<std::string> topics;
   for (const auto& publisher : waitablePublishers()) topics.push_back(publisher.first);
@@ -83,9 +91,7 @@ std::vector<std::pair<std::string, int>> parseAwaitedSubscribers(const std::stri
       std::string allowed;
       for (const std::string& name : topics) allowed += (allowed.empty() ? "" : ", ") + name;
       problems.push_back("~wait_for_subscribers: item '" + item +
-                         "' is not allowed; allowed: topic[:count] with "
-                         "a topic of " +
-                         allowed + " and a count >= 1");
+                         "' is not allowed; allowed: topic[:count] with a topic of " + allowed + " and a count >= 1");
       continue;
     }
     awaited.emplace_back(topic, count);
@@ -169,7 +175,7 @@ RigSimulator::~RigSimulator() { closeBag(); }
 void RigSimulator::openBag() {
   // As rosbag record does, the bag is written as BAG.active and renamed when closed: a bag under its
   // own name is complete. The lock on BAG.active keeps a second rig from writing the same bag.
-  const std::string active = options_.bag_path + ".active";
+  const std::string active = activeBagPath();
   auto refuse = [&](const std::string& why) {
     if (bag_lock_ >= 0) ::close(bag_lock_);
     bag_lock_ = -1;
@@ -196,7 +202,7 @@ void RigSimulator::closeBag() {
   if (bag_open_) {
     bag_.close();
     bag_open_ = false;
-    const std::string active = options_.bag_path + ".active";
+    const std::string active = activeBagPath();
     if (std::rename(active.c_str(), options_.bag_path.c_str()) != 0) {
       ROS_ERROR_STREAM("the bag stays at " << active << ": it could not be renamed (" << std::strerror(errno) << ")");
     }
@@ -229,7 +235,7 @@ void RigSimulator::addStreams(RunDriver& driver) {
   const SimulatorOptions& o = options_;
   driver.add(std::make_unique<SampledStream<Instant>>(
       o.clock_rate, Sampling::AtSteps, [](const Simulation& s) { return Instant{s.time()}; },
-      [this](const Instant& instant) { publishPaced(instant.time, [this, instant] { publishClock(instant.time); }); }));
+      [this](const Instant& instant) { publishClock(instant.time); }));
   driver.add(std::make_unique<SampledStream<LoadCellReading>>(
       o.load_cell_rate, Sampling::AtSteps, [](const Simulation& s) { return s.loadCells(); },
       [this](const LoadCellReading& cells) { emit(load_cells_pub_, "load_cells", toMsg(cells, options_.frame_id)); },
@@ -309,7 +315,7 @@ void RigSimulator::emit(ros::Publisher& publisher, const std::string& topic, con
 void RigSimulator::publishClock(double time) {
   rosgraph_msgs::Clock clock;
   clock.clock = toStamp(time);
-  clock_pub_.publish(clock);
+  publishPaced(time, [this, clock] { clock_pub_.publish(clock); });
 }
 
 void RigSimulator::publishStageState() { publishStageState(stageState(simulation())); }
@@ -515,23 +521,25 @@ bool RigSimulator::waitForSubscribers() {
       return false;
     }
     ros::spinOnce();
-    publishStageState();
-    publishClock(simulation().time());
-    ros::WallDuration(0.05).sleep();
+    standStill();
   }
   return true;  // interrupted: the run loop ends at once, with the reason
+}
+
+void RigSimulator::standStill() {
+  publishStageState();                // so that a controller learns the time and F_Z while the rig waits
+  publishClock(simulation().time());  // nodes on simulated time, and `rostopic echo /clock`, see it stand still
+  ros::WallDuration(0.05).sleep();
 }
 
 std::string RigSimulator::missingSubscribers() const {
   std::string missing;
   for (const auto& [topic, count] : awaited_subscribers_) {
-    for (const auto& [name, member] : waitablePublishers()) {
-      const ros::Publisher& publisher = this->*member;
-      const int subscribers = static_cast<int>(publisher.getNumSubscribers());
-      if (name != topic || subscribers >= count) continue;
-      missing += (missing.empty() ? "" : ", ") + publisher.getTopic() + " (" + std::to_string(subscribers) + " of " +
-                 std::to_string(count) + ")";
-    }
+    const ros::Publisher& publisher = this->*publisherNamed(topic);
+    const int subscribers = static_cast<int>(publisher.getNumSubscribers());
+    if (subscribers >= count) continue;
+    missing += (missing.empty() ? "" : ", ") + publisher.getTopic() + " (" + std::to_string(subscribers) + " of " +
+               std::to_string(count) + ")";
   }
   return missing;
 }
@@ -552,10 +560,8 @@ std::string RigSimulator::runUntilTheEnd() {
       continue;
     }
     if (paused_) {
-      publishStageState();                // so that a controller learns the time and F_Z while the rig waits
-      publishClock(simulation().time());  // nodes on simulated time, and `rostopic echo /clock`, see it stand still
       if (lattice_pub_.getNumSubscribers() > 0) lattice_pub_.publish(toMsg(simulation().snapshot(), options_.frame_id));
-      ros::WallDuration(0.05).sleep();
+      standStill();
       continue;
     }
     driver_->advance();

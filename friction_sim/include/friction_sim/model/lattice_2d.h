@@ -22,8 +22,12 @@ class Lattice2D : public Model {
 
   int nodesX() const { return nx_; }
   int nodesZ() const { return nz_; }
-  double spacing() const { return spacing_; }         ///< m, l
-  double springStiffness() const { return k_; }       ///< N/m, k
+  double spacing() const { return spacing_; }    ///< m, l
+  double springStiffness() const { return k_; }  ///< N/m, k
+  /// N/m, k = (3/4)·B·E: the horizontal and vertical bonds' stiffness that gives the scene's E (MODEL.md §2).
+  static double springStiffness(const Scene& scene) {
+    return 0.75 * scene.geometry.width * scene.material.youngs_modulus;
+  }
   double dampingRate() const { return eta_; }         ///< kg/s, η
   double foundationStiffness() const { return kf_; }  ///< N/m, k_f
   int nodeIndex(int i, int j) const { return j * nx_ + i; }

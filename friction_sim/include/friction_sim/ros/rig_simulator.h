@@ -153,8 +153,13 @@ class RigSimulator {
  private:
   /// The publishers ~wait_for_subscribers may name, by their topics' relative names.
   static const std::vector<std::pair<std::string, ros::Publisher RigSimulator::*>>& waitablePublishers();
+  /// The publisher of a waitable topic (one parseAwaitedSubscribers accepted).
+  static ros::Publisher RigSimulator::*publisherNamed(const std::string& topic);
   /// Waits at t = 0, answering services, until ~wait_for_subscribers holds; false if its timeout passed.
   bool waitForSubscribers();
+  /// While the rig stands at its time (paused, or waiting for subscribers): the stage state and the clock,
+  /// then 50 ms of wall time.
+  void standStill();
   /// "topic (n of m)" for each awaited topic short of its subscribers; empty once all have them.
   std::string missingSubscribers() const;
   /// Spins, pauses, resets, advances and paces until the run ends; returns why it ended.
@@ -162,6 +167,8 @@ class RigSimulator {
   /// The stage state, the summary and the bag at the end of the run.
   void finish(const std::string& end_reason);
   void advertise();
+  /// BAG.active: where the bag is written until it is closed.
+  std::string activeBagPath() const { return options_.bag_path + ".active"; }
   /// Opens ~bag as BAG.active, locked against a second writer; throws ConfigError if it cannot.
   void openBag();
   /// Closes the bag and renames it to its own name, then drops the lock.

@@ -34,7 +34,7 @@ Lattice2D::Lattice2D(const Scene& scene)
       spacing_(scene.geometry.length / (nx_ - 1)),
       width_(scene.geometry.width),
       mass_(scene.material.density * scene.geometry.length * scene.geometry.height * scene.geometry.width / n_),
-      k_(0.75 * scene.geometry.width * scene.material.youngs_modulus),
+      k_(springStiffness(scene)),
       eta_(std::sqrt(scene.material.damping_coefficient * k_ * mass_)),
       kf_(scene.lattice.foundation_ratio * k_),
       geometric_(scene.lattice.spring_form == SpringForm::Geometric),

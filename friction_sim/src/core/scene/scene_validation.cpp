@@ -308,7 +308,7 @@ void checkMemory(Checker& check, const Scene& s) {
 /// far below the bonds, numerically singular).
 void checkFoundation(Checker& check, const Scene& s) {
   const double spacing = s.geometry.length / (s.lattice.nodes_x - 1);
-  const double bond_stiffness = 0.75 * s.geometry.width * s.material.youngs_modulus;
+  const double bond_stiffness = Lattice2D::springStiffness(s);
   const double least_ratio = 10.0 * s.load.normal_force / (s.lattice.nodes_x * bond_stiffness * spacing);
   std::ostringstream allowed;
   allowed << ">= " << least_ratio << ", so that F_Z sinks the slider into the track by under a tenth of the "
