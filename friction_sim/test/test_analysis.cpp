@@ -446,6 +446,10 @@ TEST(FrameEventDetector, RateStateEventsEndOnTheirSlipSpeedWhileTheInterfaceCree
       EXPECT_NEAR(found[e].node_slip[node], truth[e].node_slip[node], criterion.speed * kFrameIntervalBetweenEvents);
       // The frames sample some of the steps whose largest slip speed the simulator keeps.
       EXPECT_LE(found[e].peak_slip_velocity[node], truth[e].peak_slip_velocity[node]);
+      // Each frame comes at the end of a step; the simulator watches every step.
+      if (!std::isnan(truth[e].last_slip_time[node])) {
+        EXPECT_LE(found[e].last_slip_time[node], truth[e].last_slip_time[node]);
+      }
     }
   }
 }

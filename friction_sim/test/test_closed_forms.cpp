@@ -66,6 +66,9 @@ TEST_P(SingleBlockStickSlip, MatchesTheClosedFormCycle) {
     // Released from rest at µ_s·N, the block's speed is V + ωΔ·sin ωt − V·cos ωt: its peak V + √((ωΔ)² + V²).
     const double peak_speed = speed + std::hypot(omega * delta, speed);
     EXPECT_NEAR(event.peak_slip_velocity[0], peak_speed, 1e-6 * peak_speed);
+    // It re-sticks within the step after the last one it ended sliding.
+    EXPECT_LE(event.last_slip_time[0], event.end_time);
+    EXPECT_GE(event.last_slip_time[0], event.end_time - simulation.timeStep());
     const double slip_per_cycle = speed * slip_time + 2.0 * delta;
     EXPECT_NEAR(direction * event.node_slip[0], slip_per_cycle, 1e-6 * slip_per_cycle);
     if (e + 1 < events.size()) {

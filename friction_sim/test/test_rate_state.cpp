@@ -4,12 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "friction_sim/contact/contact_interface.h"
+#include "friction_sim/instruments/results_io.h"
 #include "friction_sim/model/chain_1d.h"
+#include "friction_sim/run/run_driver.h"
 #include "friction_sim/run/simulation.h"
 #include "one_node.h"
 #include "test_helpers.h"
@@ -386,18 +392,24 @@ std::vector<std::pair<double, double>> extendedPrecursors(const Simulation& simu
   return precursors;
 }
 
-TEST(QuasiStaticCreep, CreepingSliderHasTheFullDynamicsPrecursors) {
-  // The coarse slider (29 × 16) with rate_state at 0.4 mm/s: its trailing edge creeps from F_X/F_Z ≈ 0.15
-  // on. Full dynamics takes 2.1·10⁶ steps to its first global event; with creep steps it takes a
-  // twentieth of that. Full dynamics also has four single-node events at this step (F_X/F_Z 0.16–0.23)
-  // that are not in the creep: on pmma_2d_rate_state such events go away when the step is halved.
+/// The coarse slider (29 × 16) with rate_state at 0.4 mm/s, to its first global event: its trailing
+/// edge creeps from F_X/F_Z ≈ 0.15 on.
+Scene coarseRateStateSlider(bool fast_forward) {
   Scene scene = testing::pmmaScene(29, 16);
   scene.friction.law = FrictionLawKind::RateState;
   scene.stage.program = {StageSegment{StageMode::Velocity, 4e-4}};
   scene.integrator.time_step = 4e-7;
   scene.instruments.event_slip_speed = 1e-3;
   scene.stop = StopSpec{1, 5.0, std::numeric_limits<double>::infinity()};
-  scene.integrator.fast_forward = true;
+  scene.integrator.fast_forward = fast_forward;
+  return scene;
+}
+
+TEST(QuasiStaticCreep, CreepingSliderHasTheFullDynamicsPrecursors) {
+  // Full dynamics takes 2.1·10⁶ steps to the first global event; with creep steps it takes a twentieth
+  // of that. Full dynamics also has four single-node events at this step (F_X/F_Z 0.16–0.23) that are
+  // not in the creep: on pmma_2d_rate_state such events go away when the step is halved.
+  Scene scene = coarseRateStateSlider(true);
   Simulation creeping(scene);
   creeping.run();
   scene.integrator.fast_forward = false;
@@ -419,6 +431,82 @@ TEST(QuasiStaticCreep, CreepingSliderHasTheFullDynamicsPrecursors) {
   EXPECT_NEAR(global.onset_shear_force / global.onset_normal_force,
               global_reference.onset_shear_force / global_reference.onset_normal_force, 5e-3);
   EXPECT_LT(std::abs(creeping.energy().relativeResidual()), 5e-3);
+}
+
+/// A CSV table: its header's column names, then one row of cells per line.
+struct CsvTable {
+  explicit CsvTable(const std::string& text) {
+    std::istringstream lines(text);
+    std::string line, cell;
+    std::getline(lines, line);
+    for (std::istringstream header(line); std::getline(header, cell, ',');) columns.push_back(cell);
+    while (std::getline(lines, line)) {
+      rows.emplace_back();
+      for (std::istringstream cells(line); std::getline(cells, cell, ',');) rows.back().push_back(cell);
+    }
+  }
+  bool has(const std::string& column) const {
+    return std::find(columns.begin(), columns.end(), column) != columns.end();
+  }
+  double number(std::size_t row, const std::string& column) const {
+    return std::stod(rows[row][std::find(columns.begin(), columns.end(), column) - columns.begin()]);
+  }
+  std::vector<std::string> columns;
+  std::vector<std::vector<std::string>> rows;
+};
+
+TEST(RateStateResults, TheFilesHoldEachContactsAgeingStrengthAndWhenEachNodeLastSlipped) {
+  const Scene scene = coarseRateStateSlider(true);
+  RunDriver driver(scene, requireValidScene(scene));
+  std::ostringstream stresses_csv, event_nodes_csv;
+  driver.add(stressesStream(stresses_csv, {}));
+  driver.run();
+  const Simulation& simulation = driver.simulation();
+  writeEventNodesCsv(event_nodes_csv, simulation.events(), simulation.model().interfacePositions());
+  const std::vector<SlipEvent>& events = simulation.events();
+  ASSERT_GE(events.size(), 5u);
+
+  // At every onset no contact is older than the run plus the initial age. The leading edge is that old
+  // until the precursors have loaded it enough to creep (measured: through the 11th onset).
+  const CsvTable stresses(stresses_csv.str());
+  ASSERT_TRUE(stresses.has("interface_static_coefficient"));
+  const auto nodes_x = static_cast<std::size_t>(scene.lattice.nodes_x);
+  int onsets = 0;
+  for (std::size_t first_row = 0; first_row < stresses.rows.size(); first_row += nodes_x) {
+    if (stresses.rows[first_row][1] != "onset") continue;
+    const std::size_t leading = first_row + nodes_x - 1;
+    ASSERT_DOUBLE_EQ(stresses.number(leading, "x_m"), scene.geometry.length);
+    const double oldest =
+        kPmma.staticCoefficient(scene.friction.rate_state.initial_age + stresses.number(leading, "time_s"));
+    if (onsets < 8) {
+      EXPECT_NEAR(stresses.number(leading, "interface_static_coefficient"), oldest, 1e-9 * oldest) << onsets;
+    }
+    for (std::size_t row = first_row; row < leading; ++row) {
+      EXPECT_LE(stresses.number(row, "interface_static_coefficient"), oldest * (1.0 + 1e-9));
+    }
+    ++onsets;
+  }
+  EXPECT_EQ(onsets, static_cast<int>(events.size()));
+
+  // Every node that slipped in an event did so from its first unsticking to its last slip, and the last
+  // of them stopped within a step of the event's end.
+  const CsvTable nodes(event_nodes_csv.str());
+  ASSERT_TRUE(nodes.has("last_slip_time_s"));
+  std::vector<double> latest(events.size(), -std::numeric_limits<double>::infinity());
+  for (std::size_t row = 0; row < nodes.rows.size(); ++row) {
+    const SlipEvent& event = events[static_cast<std::size_t>(nodes.number(row, "event"))];
+    const double first = nodes.number(row, "first_unstick_time_s"), last = nodes.number(row, "last_slip_time_s");
+    EXPECT_EQ(std::isnan(first), std::isnan(last));
+    if (std::isnan(first)) continue;
+    EXPECT_LE(first, last);
+    EXPECT_LE(last, event.end_time);
+    latest[event.index] = std::max(latest[event.index], last);
+  }
+  for (const SlipEvent& event : events) {
+    if (!event.unfinished) {
+      EXPECT_GE(latest[event.index], event.end_time - scene.integrator.time_step);
+    }
+  }
 }
 
 // ---- Hard cases: each stable, with the number it must give ---------------------------------------------

@@ -45,7 +45,10 @@ struct SlipEvent {
   bool unfinished = false;
   std::vector<double> node_slip;           ///< m, per interface node, displacement during the event
   std::vector<double> first_unstick_time;  ///< s, per node; NaN where the node did not slip
-  std::vector<double> front_speed;         ///< m/s, v_c per node from the first-unstick times; NaN where undefined
+  /// s, per node, the end of the last step (the simulator) or frame (the camera) in which it slipped; NaN
+  /// where it did not slip: whether the slip behind a front still runs when the front reaches a point
+  std::vector<double> last_slip_time;
+  std::vector<double> front_speed;  ///< m/s, v_c per node from the first-unstick times; NaN where undefined
   /// m/s, per node, the largest slip speed |dx/dt| it slid at during the event (0 where it did not
   /// slide): the slip velocity behind the front, which the experiments find proportional to v_c
   std::vector<double> peak_slip_velocity;

@@ -104,6 +104,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
     current_.index = next_index_++;
     current_.onset_time = frame.time;
     current_.first_unstick_time.assign(n, std::numeric_limits<double>::quiet_NaN());
+    current_.last_slip_time.assign(n, std::numeric_limits<double>::quiet_NaN());
     current_.peak_slip_velocity.assign(n, 0.0);
     in_contact_.start(n);
     double sum = 0.0;
@@ -118,9 +119,9 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   for (std::size_t node = 0; node < n; ++node) {
     if (frame.state[node] != static_cast<std::uint8_t>(ContactState::Detached)) in_contact_.touch(node);
     current_.peak_slip_velocity[node] = std::max(current_.peak_slip_velocity[node], sliding_speed[node]);
-    if (slipping[node] && std::isnan(current_.first_unstick_time[node])) {
-      current_.first_unstick_time[node] = frame.time;
-    }
+    if (!slipping[node]) continue;
+    if (std::isnan(current_.first_unstick_time[node])) current_.first_unstick_time[node] = frame.time;
+    current_.last_slip_time[node] = frame.time;
   }
   if (any_slipping) {
     quiet_frame_.reset();

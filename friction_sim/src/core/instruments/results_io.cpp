@@ -92,12 +92,13 @@ void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, con
 
 void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,
                         const std::vector<double>& node_positions) {
-  out << "event,node,x_m,slip_m,first_unstick_time_s,front_speed_m_s,peak_slip_velocity_m_s\n";
+  out << "event,node,x_m,slip_m,first_unstick_time_s,last_slip_time_s,front_speed_m_s,peak_slip_velocity_m_s\n";
   out << std::setprecision(12);
   for (const SlipEvent& e : events) {
     for (std::size_t node = 0; node < node_positions.size(); ++node) {
       out << e.index << ',' << node << ',' << node_positions[node] << ',' << e.node_slip[node] << ','
-          << e.first_unstick_time[node] << ',' << e.front_speed[node] << ',' << e.peak_slip_velocity[node] << '\n';
+          << e.first_unstick_time[node] << ',' << e.last_slip_time[node] << ',' << e.front_speed[node] << ','
+          << e.peak_slip_velocity[node] << '\n';
     }
   }
 }
@@ -113,7 +114,7 @@ void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& read
 
 void writeStressesHeader(std::ostream& out) {
   out << "event,phase,time_s,x_m,gauge_sigma_xx_Pa,gauge_sigma_zz_Pa,gauge_tau_xz_Pa,"
-         "interface_normal_stress_Pa,interface_shear_stress_Pa\n";
+         "interface_normal_stress_Pa,interface_shear_stress_Pa,interface_static_coefficient\n";
   out.precision(10);
 }
 
@@ -124,7 +125,7 @@ void writeStressRows(std::ostream& out, int event, const char* phase, const Inte
     out << event << ',' << phase << ',' << frame.time << ',' << frame.position[i] << ','
         << (gauge ? gauges.stress.sigma_xx[i] : NAN) << ',' << (gauge ? gauges.stress.sigma_zz[i] : NAN) << ','
         << (gauge ? gauges.stress.tau_xz[i] : NAN) << ',' << frame.normal_stress[i] << ',' << frame.shear_stress[i]
-        << '\n';
+        << ',' << frame.static_coefficient[i] << '\n';
   }
 }
 

@@ -93,6 +93,7 @@ void SlipEventDetector::startEvent(double step_start, double dt, const ContactIn
   normal_impulse_ = 0.0;
   quiet_since_ = kNaN;
   current_.first_unstick_time.assign(n, kNaN);
+  current_.last_slip_time.assign(n, kNaN);
   current_.peak_slip_velocity.assign(n, 0.0);
   double sum = 0.0;
   for (int node : began_) sum += positions_[node];
@@ -109,9 +110,12 @@ bool SlipEventDetector::update(double step_start, double dt, const ContactInterf
   if (!in_event_ && !began_.empty()) startEvent(step_start, dt, contact, u, loads);
   if (!in_event_) return false;
   for (std::size_t node = 0; node < positions_.size(); ++node) {
-    if (contact.state(static_cast<int>(node)) != ContactState::Sliding) continue;
+    const ContactState state = contact.state(static_cast<int>(node));
+    if (state != ContactState::Sliding) continue;
+    const double velocity = v[dofs_[node]];
     double& peak = current_.peak_slip_velocity[node];
-    peak = std::max(peak, std::abs(v[dofs_[node]]));
+    peak = std::max(peak, std::abs(velocity));
+    if (criterion_.slipping(state, velocity)) current_.last_slip_time[node] = step_start + dt;
   }
   in_contact_.note(static_cast<std::size_t>(contact.detachedCount()),
                    [&contact](std::size_t node) { return contact.state(static_cast<int>(node)); });
