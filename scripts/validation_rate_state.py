@@ -75,21 +75,42 @@ def fast_to_slow(points, fit_nodes, run_length=3):
 
 
 def onset_prestress(sweep_name, run):
-    """{event index: [(x (m), τ/σ at the interface at the event's onset)]} from a run's stresses.csv."""
+    """{event index: [(x (m), τ/σ, τ/(µ_s·σ))]} at the interface at each event's onset, from a run's
+    stresses.csv: the stress ratio, and how near each node is to failing under its own static friction."""
     out = {}
     with open(os.path.join(sweep.ROOT, "sweeps", sweep_name, "runs", run, "stresses.csv")) as handle:
         for row in csv.DictReader(handle):
             normal = float(row["interface_normal_stress_Pa"])
             if row["phase"] == "onset" and normal > 0:
+                ratio = float(row["interface_shear_stress_Pa"]) / normal
                 out.setdefault(row["event"], []).append(
-                    (float(row["x_m"]), float(row["interface_shear_stress_Pa"]) / normal))
+                    (float(row["x_m"]), ratio, ratio / float(row["interface_static_coefficient"])))
     return out
 
 
-def mean_ratio(profile, low, high):
-    """The mean τ/σ of `profile` over low <= x < high (m), or nan."""
-    ratios = [r for x, r in profile if low <= x < high]
-    return sum(ratios) / len(ratios) if ratios else float("nan")
+def mean_ratio(profile, low, high, column=1):
+    """The mean of `column` of `profile` (onset_prestress) over low <= x < high (m), or nan."""
+    values = [point[column] for point in profile if low <= point[0] < high]
+    return sum(values) / len(values) if values else float("nan")
+
+
+def slip_times(sweep_name, run):
+    """event index → [(x (m), first-unstick time (s), last-slip time (s))] of the nodes that slipped."""
+    out = {}
+    with open(os.path.join(sweep.ROOT, "sweeps", sweep_name, "runs", run, "event_nodes.csv")) as handle:
+        for r in csv.DictReader(handle):
+            first = float(r["first_unstick_time_s"])
+            if math.isfinite(first):
+                out.setdefault(r["event"], []).append((float(r["x_m"]), first, float(r["last_slip_time_s"])))
+    return out
+
+
+def still_slipping_behind(times, turn_x, slow_end_x):
+    """(slipping, all): of the nodes behind `turn_x` (m) that slipped, those still slipping when the front
+    has run slow to `slow_end_x` (m), the moment its last slow node unstuck."""
+    reached = max((first for x, first, _ in times if x <= slow_end_x), default=math.nan)
+    behind = [last for x, _, last in times if x < turn_x]
+    return sum(1 for last in behind if last >= reached), len(behind)
 
 
 def slide_peaks(run_dir, protocol_path):
@@ -178,31 +199,52 @@ def sections(data):
     # Fast to slow within one event.
     fit_nodes = int(_SCENE["instruments"]["front_fit_nodes"])
     transitions = [(e["index"], t) for e in with_front for t in [fast_to_slow(nodes.get(e["index"], []), fit_nodes)] if t]
-    # The prestress τ/σ at the event's onset where the front ran fast (the three nodes before it turned) and
-    # where it ran slow.
+    # The prestress τ/σ at the event's onset, and τ/(µ_s·σ), where the front ran fast (the three nodes before
+    # it turned) and where it ran slow; and whether the slip behind still ran while the front ran slow.
     prestress = onset_prestress("rate_state_normal_load", DEFAULT_RUN)
+    times = slip_times("rate_state_normal_load", DEFAULT_RUN)
     spacing = float(_SCENE["geometry"]["length"]) / (int(_SCENE["lattice"]["nodes_x"]) - 1)
-    rows = [(i, t, mean_ratio(prestress.get(i, []), t[0] - 3 * spacing, t[0]),
-             mean_ratio(prestress.get(i, []), t[0], t[0] + t[1] + 0.5 * spacing)) for i, t in transitions]
-    lower = sum(1 for _, _, fast, slow in rows if slow < fast)
+    rows = []
+    for i, (turn, run_slow) in transitions:
+        profile = prestress.get(i, [])
+        fast, slow = (turn - 3 * spacing, turn), (turn, turn + run_slow + 0.5 * spacing)
+        rows.append((i, turn, run_slow, mean_ratio(profile, *fast), mean_ratio(profile, *slow),
+                     mean_ratio(profile, *fast, column=2), mean_ratio(profile, *slow, column=2),
+                     still_slipping_behind(times.get(i, []), turn, turn + run_slow)))
+    lower = sum(1 for row in rows if row[4] < row[3])
+    nearer = sum(1 for row in rows if row[6] < row[5])
+    carried = sum(1 for row in rows if row[7][1] > 0 and row[7][0] == row[7][1])
     L += ["### 10.2 The fast-to-slow transition within one event", "",
           "*Experiment* (Trømborg et al., PNAS 2014): a fast front turns slow as it enters a region of low "
           "prestress, carried by the slow slip left behind.", "",
           "*Rig*: events whose front runs between c_R/10 and c_L for three nodes and then below c_R/10 for "
-          "three or more, beyond the nucleation's %d nodes (v_c(x) in §10.1's figure), with the interface's "
-          "prestress τ/σ at the event's onset where the front ran fast (its last three nodes) and where it ran "
-          "slow:" % fit_nodes, "",
-          "| event | turns slow at x (mm) | runs slow for (mm) | τ/σ where fast | τ/σ where slow |", "|---|---|---|---|---|"]
-    L += ["| %s | %.0f | %.0f | %.3f | %.3f |" % (i, t[0] * 1e3, t[1] * 1e3, fast, slow) for i, t, fast, slow in rows]
+          "three or more, beyond the nucleation's %d nodes (v_c(x) in §10.1's figure). At the event's onset, "
+          "where the front ran fast (its last three nodes) and where it ran slow: the prestress τ/σ, and "
+          "τ/(µ_s·σ), the share of its own static friction µ(0, φ) each contact bears. *Behind*: of the nodes "
+          "the front passed before it turned slow, those still slipping when it ended its slow run "
+          "(`last_slip_time_s` of event_nodes.csv):" % fit_nodes, "",
+          "| event | turns slow at x (mm) | runs slow for (mm) | τ/σ where fast | τ/σ where slow "
+          "| τ/(µ_s·σ) where fast | τ/(µ_s·σ) where slow | behind, still slipping |",
+          "|---|---|---|---|---|---|---|---|"]
+    L += ["| %s | %.0f | %.0f | %.3f | %.3f | %.3f | %.3f | %d of %d |" % (
+        i, turn * 1e3, run_slow * 1e3, fast, slow, fast_share, slow_share, behind[0], behind[1])
+        for i, turn, run_slow, fast, slow, fast_share, slow_share, behind in rows]
     L += ["", "*Agreement*: %s" % (
-        "a fast front turning slow is shown in %d of %d events with a front; in %d of them the front slows where "
-        "τ/σ is lower, as Trømborg et al. find%s. Whether the slow part is carried by the slow slip left behind "
-        "is not analysed." % (len(transitions), len(with_front), lower,
-                              "" if lower == len(rows) else
-                              ", in the others where it is higher. With ageing, τ/σ alone does not say how close "
-                              "a region is to failing: the contacts ahead of the creeping trailing edge are old "
-                              "and strong (µ_s up to 0.56), those behind it young, and the results files do not "
-                              "yet hold µ_s at the onset to divide by")
+        "a fast front turning slow is shown in %d of %d events with a front. The front slows where τ/σ is "
+        "lower in %d of them, and where τ/(µ_s·σ) is lower — where the contacts are further from failing "
+        "under their own, age-dependent, static friction — in %d: %s In %d of %d the whole region behind "
+        "the turn still slips while the front runs slow: %s" % (
+            len(transitions), len(with_front), lower, nearer,
+            "with ageing the measure that matters is τ/(µ_s·σ), and by it the rig agrees with Trømborg et al."
+            if nearer == len(rows) else
+            "by it the rig agrees with Trømborg et al. in most events." if 2 * nearer > len(rows) else
+            "the rig does not show the low-prestress mechanism.",
+            carried, len(rows),
+            "the slow front runs with the slow slip behind it, as Trømborg et al. describe%s." % (
+                "" if carried == len(rows) else
+                "; in the other %d the slip behind had stopped, and the front ran slow on its own" % (len(rows) - carried))
+            if 2 * carried > len(rows) else
+            "in the others the slip behind has stopped, so the slow front runs on its own.")
         if transitions else "not shown at this resolution."), ""]
 
     # Slip velocity against front speed.
