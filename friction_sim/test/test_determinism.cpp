@@ -21,9 +21,9 @@ struct Pin {
 };
 
 constexpr Pin kPins[] = {
-    {"single_block", 0xe1ac1a59a82fec52ULL}, {"pmma_1d_side", 0x1134ed5206e1b6ccULL},
-    {"pmma_1d_top", 0x556f54bc1cb604d3ULL},  {"pmma_2d", 0xe8c93851ef6a52e9ULL},
-    {"rate_state", 0x3ea5e3ef44d77e9dULL},
+    {"single_block", 0x33ff500570b44db8ULL}, {"pmma_1d_side", 0xb056c9eb2adbc6e5ULL},
+    {"pmma_1d_top", 0xd156e33d8925d422ULL},  {"pmma_2d", 0xdd43acf8a7384891ULL},
+    {"rate_state", 0x4ccef46cce7c4279ULL},
 };
 
 void PrintTo(const Pin& pin, std::ostream* out) { *out << pin.scene; }

@@ -182,7 +182,7 @@ TEST(RunDriver, AnEventUnderWayWhereTheRunStopsIsReportedUnfinished) {
   const double slipping = simulation.time() - event.onset_time;  // the run ends on a step: up to dt past its stop
   const double slid = drop * (1.0 - std::cos(std::sqrt(kStageStiffness / mass) * slipping)) + kStageSpeed * slipping;
   EXPECT_NEAR(event.node_slip[0] / slid, 1.0, 1e-3);
-  EXPECT_TRUE(summarize(simulation, 0.0).last_event_unfinished);
+  EXPECT_TRUE(summarize(simulation, 0.0).events.last_event_unfinished);
   // Nothing more to end.
   driver.finishRun();
   EXPECT_EQ(simulation.events().size(), 1u);

@@ -5,8 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -116,8 +114,8 @@ class ProgressLine : public friction::RunStream {
     last_ = now;
     const double wall = std::chrono::duration<double>(now - start_).count();
     const double time = simulation.time(), limit = simulation.scene().stop.time;
-    std::fprintf(stderr, "\r\033[Kt = %.4g s of %.4g s, %.0f steps/s, %.0f jumps/s, %zu events", time, limit,
-                 simulation.steps() / wall, simulation.jumps() / wall, simulation.events().size());
+    std::fprintf(stderr, "\r\033[Kt = %.4g s of %.4g s, %.0f steps/s, %.0f jumps/s, %d events", time, limit,
+                 simulation.steps() / wall, simulation.jumps() / wall, simulation.eventTally().events);
     if (std::isfinite(limit) && time > 0.0) std::fprintf(stderr, ", at most %.0f s left", (limit - time) * wall / time);
     std::fflush(stderr);
     shown_ = true;
@@ -133,20 +131,12 @@ class ProgressLine : public friction::RunStream {
   bool shown_ = false;
 };
 
-/// The loading curve into `loading`, stresses.csv into `stresses_csv`, and each event printed as it ends.
-void addStreams(friction::RunDriver& driver, std::vector<friction::LoadCellReading>& loading,
-                std::ofstream& stresses_csv) {
-  driver.add(std::make_unique<friction::SampledStream<friction::LoadCellReading>>(
-      driver.simulation().scene().instruments.loading_curve_rate, friction::Sampling::Interpolated,
-      [](const friction::Simulation& s) { return s.loadCells(); },
-      [&loading](const friction::LoadCellReading& reading) { loading.push_back(reading); }));
-  driver.add(
-      friction::stressesStream(stresses_csv, [](const friction::Simulation& s, const friction::SlipEvent& event) {
-        std::cout << "event " << event.index << " at t = " << event.onset_time
-                  << " s: F_X/F_Z = " << event.onset_shear_force / event.onset_normal_force
-                  << ", L_p/L = " << event.rupture_length / s.scene().geometry.length
-                  << (event.global ? " (global)" : "") << std::endl;
-      }));
+/// Each event's line on standard output as it ends.
+void printEvent(const friction::Simulation& s, const friction::SlipEvent& event) {
+  std::cout << "event " << event.index << " at t = " << event.onset_time
+            << " s: F_X/F_Z = " << event.onset_shear_force / event.onset_normal_force
+            << ", L_p/L = " << event.rupture_length / s.scene().geometry.length << (event.global ? " (global)" : "")
+            << std::endl;
 }
 
 int run(int argc, char** argv) {
@@ -169,11 +159,12 @@ int run(int argc, char** argv) {
   const friction::Simulation& simulation = driver.simulation();
   const std::size_t scheduled_commands = scheduleCommands(args, protocol, driver);
   const std::string out_dir = args.out_dir.empty() ? "results/" + scene.name : args.out_dir;
-  std::error_code directory_error;
-  std::filesystem::create_directories(out_dir, directory_error);
-  if (directory_error) return refuseOutput(out_dir, "cannot create the directory (" + directory_error.message() + ")");
-  std::ofstream stresses_csv(out_dir + "/stresses.csv");
-  if (!stresses_csv) return refuseOutput(out_dir, "cannot create files in it");
+  std::optional<friction::ResultsFolder> results;
+  try {
+    results.emplace(out_dir);
+  } catch (const std::runtime_error& error) {
+    return refuseOutput(out_dir, error.what());
+  }
   int applied_commands = 0;
   driver.onCommandDue([&](const friction::TimedCommand& command, const std::string& refusal) {
     if (refusal.empty()) {
@@ -182,9 +173,8 @@ int run(int argc, char** argv) {
       std::cerr << "warning: command at t = " << command.time << " s refused: " << refusal << "\n";
     }
   });
-  std::vector<friction::LoadCellReading> loading{simulation.loadCells()};
   ProgressLine* progress = isatty(fileno(stderr)) ? &driver.add(std::make_unique<ProgressLine>()) : nullptr;
-  addStreams(driver, loading, stresses_csv);
+  results->addStreams(driver, printEvent);
   driver.run();
   if (progress) progress->clear();
   driver.finishRun();
@@ -198,7 +188,7 @@ int run(int argc, char** argv) {
     std::cout << "fast-forward: " << simulation.jumps() << " jumps covering " << simulation.jumpedTime() << " s of "
               << simulation.time() << " s\n";
   }
-  if (!stresses_csv.flush() || !friction::writeRunEndFiles(out_dir, simulation, loading, wall, std::cout)) {
+  if (!results->finish(simulation, wall, std::cout)) {
     return refuseOutput(out_dir, "a result file could not be written in full");
   }
   std::cout << "results written to " << out_dir << "/\n";

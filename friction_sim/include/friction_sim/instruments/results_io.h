@@ -1,7 +1,8 @@
-// Plain-text results of a run: the slip-event table, the per-node event table, the loading curve and
-// the one-screen summary.
+// Plain-text results of a run: the slip-event table, the per-node event table, the loading curve, the
+// stresses at each event and the one-screen summary.
 #pragma once
 
+#include <fstream>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -13,24 +14,10 @@
 
 namespace friction {
 
-struct PrecursorPoint {
-  double shear_ratio = 0.0;   ///< F_X/F_Z at onset
-  double length_ratio = 0.0;  ///< L_p/L
-};
-
 struct RunSummary {
-  std::string scene_name;              ///< the scene's name
-  std::string stop_reason;             ///< which stop condition ended the run, or why it was cut short
-  int events = 0;                      ///< slip events that ended
-  bool last_event_unfinished = false;  ///< the run stopped during its last event (SlipEvent::unfinished)
-  int precursors = 0;                  ///< non-global events before the first global one, back-slips not counted
-  int back_slips = 0;  ///< events before the first global one in which the interface slid back (SlipEvent::backSlip)
-  int single_node_precursors = 0;  ///< of those, events in which one node alone slipped (L_p = 0): no front ran
-  std::vector<PrecursorPoint> precursor_points;
-  /// µ_s,macro = F_X/F_Z at the first global event, at its peak (SlipEvent::peak_shear_force; NaN if none)
-  double static_friction_macro = 0.0;
-  /// µ_k,macro = mean F_X / mean F_Z over the first global event, from onset to end (NaN if none)
-  double kinetic_friction_macro = 0.0;
+  std::string scene_name;       ///< the scene's name
+  std::string stop_reason;      ///< which stop condition ended the run, or why it was cut short
+  EventTally events;            ///< the run's slip events summed up
   double simulated_time = 0.0;  ///< s
   long long steps = 0;          ///< time steps integrated (a fast-forward jump counts as none)
   double wall_time = 0.0;       ///< s
@@ -45,11 +32,16 @@ void printSummary(std::ostream& out, const RunSummary& summary);
 
 /// One row per event. Its front speed is the running front's median v_c (summarizeFrontSpeeds), also as
 /// v_c/c_S and v_c/c_R (MODEL.md §6), with the count of fits left out of it.
+void writeEventsHeader(std::ostream& out);
+void writeEventRow(std::ostream& out, const SlipEvent& event, const Scene& scene);
 void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, const Scene& scene);
-/// One row per (event, interface node): slip, first-unstick time and front speed.
+/// One row per (event, interface node): slip, first-unstick and last-slip times, front speed, peak slip velocity.
+void writeEventNodesHeader(std::ostream& out);
+void writeEventNodeRows(std::ostream& out, const SlipEvent& event, const std::vector<double>& node_positions);
 void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,
                         const std::vector<double>& node_positions);
-void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& readings);
+void writeLoadingHeader(std::ostream& out);
+void writeLoadingRow(std::ostream& out, const LoadCellReading& reading);
 /// stresses.csv, written as the run goes: its header, then per event and `phase` (onset, end) one row per
 /// interface node with the strain gauge above it (NaN where there is none) and the interface's stresses.
 void writeStressesHeader(std::ostream& out);
@@ -59,10 +51,23 @@ void writeStressRows(std::ostream& out, int event, const char* phase, const Inte
 /// state that gave way, at its end the state then; `ended`, if given, is called after the end's rows.
 std::unique_ptr<EventStream> stressesStream(std::ostream& out, const EventStream::Ended& ended = nullptr);
 
-/// The result folder's files written at a run's end, in `out_dir`: events.csv, event_nodes.csv,
-/// loading.csv, scene.yaml (the scene as run) and summary.txt, the summary also printed to `console`.
-/// False if one could not be written in full.
-bool writeRunEndFiles(const std::string& out_dir, const Simulation& simulation,
-                      const std::vector<LoadCellReading>& loading, double wall_time, std::ostream& console);
+/// A run's result folder (docs/offline_runner.md), written as the run goes so that its memory stays
+/// flat however long it runs: events.csv, event_nodes.csv, loading.csv and stresses.csv row by row,
+/// scene.yaml and summary.txt at the end.
+class ResultsFolder {
+ public:
+  /// Creates `directory` and its files; throws std::runtime_error, saying why, if it cannot.
+  explicit ResultsFolder(const std::string& directory);
+  /// Registers the streams that write the tables on `driver`, the loading curve at the scene's
+  /// instruments.loading_curve_rate from the state now; `ended` is called after each event's rows.
+  void addStreams(RunDriver& driver, const EventStream::Ended& ended = nullptr);
+  /// Writes scene.yaml and summary.txt, the summary also to `console`. False if a file could not be
+  /// written in full.
+  bool finish(const Simulation& simulation, double wall_time, std::ostream& console);
+
+ private:
+  std::string directory_;
+  std::ofstream events_, event_nodes_, loading_, stresses_;
+};
 
 }  // namespace friction

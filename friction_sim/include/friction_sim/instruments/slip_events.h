@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -60,6 +61,48 @@ struct SlipEvent {
   /// it stored relaxes, or beside a trailing corner that lifts off: an event, but no precursor of
   /// sliding, whatever its extent (a global one is a global event, slid back as a whole).
   bool backSlip() const { return meanSlip() < 0.0; }
+};
+
+/// FNV-1a over bytes: the run's state hash (Simulation::stateHash), its events' included.
+class StateHash {
+ public:
+  void mix(const void* data, std::size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < bytes; ++i) {
+      value_ ^= p[i];
+      value_ *= 1099511628211ULL;
+    }
+  }
+  std::uint64_t value() const { return value_; }
+
+ private:
+  std::uint64_t value_ = 1469598103934665603ULL;
+};
+
+/// A precursor in the L_p/L–F_X/F_Z plane.
+struct PrecursorPoint {
+  double shear_ratio = 0.0;   ///< F_X/F_Z at onset
+  double length_ratio = 0.0;  ///< L_p/L
+};
+
+/// A run's events summed up as each ends, so that the events themselves need not all be kept and a long
+/// run's memory stays flat: the counts, the precursors before the first global event, that event's
+/// macroscopic friction (MODEL.md §6), and a hash of every event for the run's state hash.
+struct EventTally {
+  int events = 0;                      ///< slip events that ended
+  int global_events = 0;               ///< of them, global
+  bool last_event_unfinished = false;  ///< the run stopped during its last event (SlipEvent::unfinished)
+  int precursors = 0;                  ///< non-global events before the first global one, back-slips not counted
+  int back_slips = 0;  ///< events before the first global one in which the interface slid back (SlipEvent::backSlip)
+  int single_node_precursors = 0;  ///< of those, events in which one node alone slipped (L_p = 0): no front ran
+  std::vector<PrecursorPoint> precursor_points;
+  /// µ_s,macro = F_X/F_Z at the first global event, at its peak (SlipEvent::peak_shear_force; NaN if none)
+  double static_friction_macro = std::numeric_limits<double>::quiet_NaN();
+  /// µ_k,macro = mean F_X / mean F_Z over the first global event, from onset to end (NaN if none)
+  double kinetic_friction_macro = std::numeric_limits<double>::quiet_NaN();
+  StateHash hash;  ///< of every event's times, forces, extent and slips
+  /// Counts `event` in, on a slider of length `slider_length` (m).
+  void add(const SlipEvent& event, double slider_length);
 };
 
 /// The nodes that touched the track during an event so far: every one while none is lifted, which is
@@ -133,8 +176,12 @@ class SlipEventDetector {
   bool finishUnfinished(double time, double shear_force, const Vector& u);
   /// In the last update a node began slipping, or an event's quiet spell began (SlipCriterion).
   bool slipChangedLastUpdate() const { return !began_.empty() || quiet_began_; }
+  /// The latest events, oldest first: every one of a run with fewer than 2·kKeptEvents, and at least the
+  /// last kKeptEvents of a longer run, whose earlier ones are only in tally(). `index` is each one's in
+  /// the run.
   const std::vector<SlipEvent>& events() const { return events_; }
-  int globalEventCount() const { return global_count_; }
+  const EventTally& tally() const { return tally_; }
+  static constexpr std::size_t kKeptEvents = 256;
 
  private:
   /// Starts an event at the step's earliest onset of slip among began_.
@@ -178,7 +225,7 @@ class SlipEventDetector {
   double normal_impulse_ = 0.0;    ///< N·s, ∫F_Z dt
   std::vector<double> onset_u_;
   std::vector<SlipEvent> events_;
-  int global_count_ = 0;
+  EventTally tally_;
 };
 
 /// The nodes of a front-speed fit of `fit_nodes` nodes centred on a node: as many at lower x as at

@@ -79,7 +79,9 @@ class Simulation : public Dynamics {
   GaugeProfile gaugeProfile() const;
   LatticeSnapshot snapshot() const;
   EnergyBudget energy() const;
+  /// The latest slip events (SlipEventDetector::events); all of them are counted in eventTally().
   const std::vector<SlipEvent>& events() const { return detector_.events(); }
+  const EventTally& eventTally() const { return detector_.tally(); }
   /// True if the last step ended a slip event (events().back()).
   bool eventEndedLastStep() const { return event_ended_; }
   /// True if a slip event started in the last step.
@@ -93,7 +95,7 @@ class Simulation : public Dynamics {
   /// Ends the slip event under way, if any, where the run is now, flagged unfinished: for a caller that
   /// stops the run here. Returns true if it ended one (eventEndedLastStep() then says so too).
   bool finishUnfinishedEvent();
-  int globalEventCount() const { return detector_.globalEventCount(); }
+  int globalEventCount() const { return detector_.tally().global_events; }
 
   /// Stage commands from a controller replace the scene's stage program.
   Stage& stage() { return stage_; }

@@ -87,31 +87,20 @@ EnergyBudget Simulation::energy() const {
 }
 
 std::uint64_t Simulation::stateHash() const {
-  std::uint64_t hash = 1469598103934665603ULL;
-  auto mix = [&hash](const void* data, std::size_t bytes) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < bytes; ++i) {
-      hash ^= p[i];
-      hash *= 1099511628211ULL;
-    }
-  };
-  mix(&time_, sizeof time_);
-  mix(u_.data(), sizeof(double) * u_.size());
-  mix(v_.data(), sizeof(double) * v_.size());
+  StateHash hash;
+  hash.mix(&time_, sizeof time_);
+  hash.mix(u_.data(), sizeof(double) * u_.size());
+  hash.mix(v_.data(), sizeof(double) * v_.size());
   for (int node = 0; node < contact_.size(); ++node) {
     const auto state = contact_.state(node);
-    mix(&state, sizeof state);
+    hash.mix(&state, sizeof state);
   }
   // A law's own state (a contact's age), for the laws that keep one.
   const std::vector<double> law_state = contact_.law().stateNumbers();
-  mix(law_state.data(), sizeof(double) * law_state.size());
-  for (const SlipEvent& event : events()) {
-    const double numbers[] = {event.onset_time,       event.end_time,       event.onset_shear_force,
-                              event.mean_shear_force, event.rupture_length, event.nucleation_position};
-    mix(numbers, sizeof numbers);
-    mix(event.node_slip.data(), sizeof(double) * event.node_slip.size());
-  }
-  return hash;
+  hash.mix(law_state.data(), sizeof(double) * law_state.size());
+  const std::uint64_t events = eventTally().hash.value();
+  hash.mix(&events, sizeof events);
+  return hash.value();
 }
 
 }  // namespace friction

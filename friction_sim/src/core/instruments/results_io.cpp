@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <stdexcept>
 
 #include "friction_sim/scene/scene_io.h"
 
@@ -12,28 +14,9 @@ namespace friction {
 
 RunSummary summarize(const Simulation& simulation, double wall_time) {
   RunSummary summary;
-  const Scene& scene = simulation.scene();
-  summary.scene_name = scene.name;
+  summary.scene_name = simulation.scene().name;
   summary.stop_reason = simulation.stopReason();
-  summary.events = static_cast<int>(simulation.events().size());
-  summary.last_event_unfinished = !simulation.events().empty() && simulation.events().back().unfinished;
-  summary.static_friction_macro = std::numeric_limits<double>::quiet_NaN();
-  summary.kinetic_friction_macro = std::numeric_limits<double>::quiet_NaN();
-  for (const SlipEvent& event : simulation.events()) {
-    if (event.global) {
-      summary.static_friction_macro = event.peakShearRatio();
-      summary.kinetic_friction_macro = event.meanShearRatio();
-      break;
-    }
-    if (event.backSlip()) {
-      ++summary.back_slips;
-      continue;
-    }
-    ++summary.precursors;
-    if (event.rupture_length == 0.0) ++summary.single_node_precursors;
-    summary.precursor_points.push_back(
-        {event.onset_shear_force / event.onset_normal_force, event.rupture_length / scene.geometry.length});
-  }
+  summary.events = simulation.eventTally();
   summary.simulated_time = simulation.time();
   summary.steps = simulation.steps();
   summary.wall_time = wall_time;
@@ -49,67 +32,80 @@ void printSummary(std::ostream& out, const RunSummary& s) {
       << " s (stability limit " << s.stability_limit << " s)\n"
       << "  wall time " << std::setprecision(3) << s.wall_time << " s, " << std::setprecision(4)
       << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
-      << "  slip events: " << s.events << ", precursors before the first global event: " << s.precursors;
-  if (s.single_node_precursors > 0)
-    out << " (single-node slips, L_p = 0, among them: " << s.single_node_precursors << ")";
-  if (s.back_slips > 0) out << "; back-slips before it, not counted: " << s.back_slips;
-  if (s.last_event_unfinished) out << "; the last one unfinished (the run stopped during it)";
+      << "  slip events: " << s.events.events << ", precursors before the first global event: " << s.events.precursors;
+  if (s.events.single_node_precursors > 0)
+    out << " (single-node slips, L_p = 0, among them: " << s.events.single_node_precursors << ")";
+  if (s.events.back_slips > 0) out << "; back-slips before it, not counted: " << s.events.back_slips;
+  if (s.events.last_event_unfinished) out << "; the last one unfinished (the run stopped during it)";
   out << "\n";
-  if (!s.precursor_points.empty()) {
+  if (!s.events.precursor_points.empty()) {
     out << "  precursors (F_X/F_Z, L_p/L):";
-    for (const PrecursorPoint& point : s.precursor_points) {
+    for (const PrecursorPoint& point : s.events.precursor_points) {
       out << " (" << std::setprecision(4) << point.shear_ratio << ", " << point.length_ratio << ")";
     }
     out << "\n";
   }
-  out << "  mu_s,macro = F_X/F_Z at the first global event: " << s.static_friction_macro << "\n"
-      << "  mu_k,macro = mean F_X / mean F_Z over that event: " << s.kinetic_friction_macro << "\n"
+  out << "  mu_s,macro = F_X/F_Z at the first global event: " << s.events.static_friction_macro << "\n"
+      << "  mu_k,macro = mean F_X / mean F_Z over that event: " << s.events.kinetic_friction_macro << "\n"
       << "  energy-balance residual (relative): " << std::setprecision(3) << s.relative_energy_residual
       << (std::isnan(s.relative_energy_residual) ? " (no energy changed hands: nothing to balance)" : "") << "\n";
 }
 
-void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, const Scene& scene) {
+void writeEventsHeader(std::ostream& out) {
   out << "index,onset_time_s,end_time_s,onset_shear_force_N,onset_normal_force_N,shear_ratio,"
          "end_shear_force_N,nucleation_x_m,slip_min_x_m,slip_max_x_m,rupture_length_m,length_ratio,global,"
          "median_front_speed_m_s,front_speed_over_c_s,front_speed_over_c_r,front_fits_left_out,"
          "mean_shear_force_N,mean_normal_force_N,mean_shear_ratio,peak_shear_force_N,peak_shear_ratio,mean_slip_m,"
          "unfinished\n";
   out << std::setprecision(12);
+}
+
+void writeEventRow(std::ostream& out, const SlipEvent& e, const Scene& scene) {
   const double slider_length = scene.geometry.length;
   const WaveSpeeds speeds = waveSpeeds(scene);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (const SlipEvent& e : events) {
-    out << e.index << ',' << e.onset_time << ',' << e.end_time << ',' << e.onset_shear_force << ','
-        << e.onset_normal_force << ',' << e.onset_shear_force / e.onset_normal_force << ',' << e.end_shear_force << ','
-        << e.nucleation_position << ',' << e.slip_min_x << ',' << e.slip_max_x << ',' << e.rupture_length << ','
-        << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << e.median_front_speed << ','
-        << e.median_front_speed / speeds.shear << ','
-        << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out << ','
-        << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio() << ',' << e.peak_shear_force
-        << ',' << e.peakShearRatio() << ',' << e.meanSlip() << ',' << (e.unfinished ? 1 : 0) << '\n';
+  out << e.index << ',' << e.onset_time << ',' << e.end_time << ',' << e.onset_shear_force << ','
+      << e.onset_normal_force << ',' << e.onset_shear_force / e.onset_normal_force << ',' << e.end_shear_force << ','
+      << e.nucleation_position << ',' << e.slip_min_x << ',' << e.slip_max_x << ',' << e.rupture_length << ','
+      << e.rupture_length / slider_length << ',' << (e.global ? 1 : 0) << ',' << e.median_front_speed << ','
+      << e.median_front_speed / speeds.shear << ','
+      << (speeds.rayleigh > 0.0 ? e.median_front_speed / speeds.rayleigh : nan) << ',' << e.front_fits_left_out << ','
+      << e.mean_shear_force << ',' << e.mean_normal_force << ',' << e.meanShearRatio() << ',' << e.peak_shear_force
+      << ',' << e.peakShearRatio() << ',' << e.meanSlip() << ',' << (e.unfinished ? 1 : 0) << '\n';
+}
+
+void writeEventsCsv(std::ostream& out, const std::vector<SlipEvent>& events, const Scene& scene) {
+  writeEventsHeader(out);
+  for (const SlipEvent& event : events) writeEventRow(out, event, scene);
+}
+
+void writeEventNodesHeader(std::ostream& out) {
+  out << "event,node,x_m,slip_m,first_unstick_time_s,last_slip_time_s,front_speed_m_s,peak_slip_velocity_m_s\n";
+  out << std::setprecision(12);
+}
+
+void writeEventNodeRows(std::ostream& out, const SlipEvent& e, const std::vector<double>& node_positions) {
+  for (std::size_t node = 0; node < node_positions.size(); ++node) {
+    out << e.index << ',' << node << ',' << node_positions[node] << ',' << e.node_slip[node] << ','
+        << e.first_unstick_time[node] << ',' << e.last_slip_time[node] << ',' << e.front_speed[node] << ','
+        << e.peak_slip_velocity[node] << '\n';
   }
 }
 
 void writeEventNodesCsv(std::ostream& out, const std::vector<SlipEvent>& events,
                         const std::vector<double>& node_positions) {
-  out << "event,node,x_m,slip_m,first_unstick_time_s,last_slip_time_s,front_speed_m_s,peak_slip_velocity_m_s\n";
-  out << std::setprecision(12);
-  for (const SlipEvent& e : events) {
-    for (std::size_t node = 0; node < node_positions.size(); ++node) {
-      out << e.index << ',' << node << ',' << node_positions[node] << ',' << e.node_slip[node] << ','
-          << e.first_unstick_time[node] << ',' << e.last_slip_time[node] << ',' << e.front_speed[node] << ','
-          << e.peak_slip_velocity[node] << '\n';
-    }
-  }
+  writeEventNodesHeader(out);
+  for (const SlipEvent& event : events) writeEventNodeRows(out, event, node_positions);
 }
 
-void writeLoadingCsv(std::ostream& out, const std::vector<LoadCellReading>& readings) {
+void writeLoadingHeader(std::ostream& out) {
   out << "time_s,stage_position_m,shear_force_N,normal_force_N,interface_normal_sum_N,sliding_nodes\n";
   out << std::setprecision(12);
-  for (const LoadCellReading& r : readings) {
-    out << r.time << ',' << r.stage_position << ',' << r.shear_force << ',' << r.normal_force << ','
-        << r.interface_normal_sum << ',' << r.sliding_nodes << '\n';
-  }
+}
+
+void writeLoadingRow(std::ostream& out, const LoadCellReading& r) {
+  out << r.time << ',' << r.stage_position << ',' << r.shear_force << ',' << r.normal_force << ','
+      << r.interface_normal_sum << ',' << r.sliding_nodes << '\n';
 }
 
 void writeStressesHeader(std::ostream& out) {
@@ -134,7 +130,7 @@ std::unique_ptr<EventStream> stressesStream(std::ostream& out, const EventStream
   return std::make_unique<EventStream>(
       [&out](const Simulation& s) {
         // The nodes that unstuck in the onset step, at their thresholds.
-        const int event = static_cast<int>(s.events().size());
+        const int event = s.eventTally().events;
         writeStressRows(out, event, "onset", s.interfaceFrameBeforeUnsticking(), s.gaugeProfile());
       },
       [&out, ended](const Simulation& s, const SlipEvent& event) {
@@ -143,18 +139,41 @@ std::unique_ptr<EventStream> stressesStream(std::ostream& out, const EventStream
       });
 }
 
-bool writeRunEndFiles(const std::string& out_dir, const Simulation& simulation,
-                      const std::vector<LoadCellReading>& loading, double wall_time, std::ostream& console) {
-  std::ofstream events_csv(out_dir + "/events.csv"), nodes_csv(out_dir + "/event_nodes.csv"),
-      loading_csv(out_dir + "/loading.csv"), scene_yaml(out_dir + "/scene.yaml"), summary_txt(out_dir + "/summary.txt");
-  writeEventsCsv(events_csv, simulation.events(), simulation.scene());
-  writeEventNodesCsv(nodes_csv, simulation.events(), simulation.model().interfacePositions());
-  writeLoadingCsv(loading_csv, loading);
+ResultsFolder::ResultsFolder(const std::string& directory) : directory_(directory) {
+  std::error_code error;
+  std::filesystem::create_directories(directory, error);
+  if (error) throw std::runtime_error("cannot create the directory (" + error.message() + ")");
+  events_.open(directory + "/events.csv");
+  event_nodes_.open(directory + "/event_nodes.csv");
+  loading_.open(directory + "/loading.csv");
+  stresses_.open(directory + "/stresses.csv");
+  if (!events_ || !event_nodes_ || !loading_ || !stresses_) throw std::runtime_error("cannot create files in it");
+  writeEventsHeader(events_);
+  writeEventNodesHeader(event_nodes_);
+  writeLoadingHeader(loading_);
+}
+
+void ResultsFolder::addStreams(RunDriver& driver, const EventStream::Ended& ended) {
+  const Simulation& simulation = driver.simulation();
+  writeLoadingRow(loading_, simulation.loadCells());
+  driver.add(std::make_unique<SampledStream<LoadCellReading>>(
+      simulation.scene().instruments.loading_curve_rate, Sampling::Interpolated,
+      [](const Simulation& s) { return s.loadCells(); },
+      [this](const LoadCellReading& reading) { writeLoadingRow(loading_, reading); }));
+  driver.add(stressesStream(stresses_, [this, ended](const Simulation& s, const SlipEvent& event) {
+    writeEventRow(events_, event, s.scene());
+    writeEventNodeRows(event_nodes_, event, s.model().interfacePositions());
+    if (ended) ended(s, event);
+  }));
+}
+
+bool ResultsFolder::finish(const Simulation& simulation, double wall_time, std::ostream& console) {
+  std::ofstream scene_yaml(directory_ + "/scene.yaml"), summary_txt(directory_ + "/summary.txt");
   scene_yaml << sceneToYaml(simulation.scene());
   const RunSummary summary = summarize(simulation, wall_time);
   printSummary(summary_txt, summary);
   printSummary(console, summary);
-  for (std::ofstream* file : {&events_csv, &nodes_csv, &loading_csv, &scene_yaml, &summary_txt}) {
+  for (std::ofstream* file : {&events_, &event_nodes_, &loading_, &stresses_, &scene_yaml, &summary_txt}) {
     if (!file->flush()) return false;
   }
   return true;

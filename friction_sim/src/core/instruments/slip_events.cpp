@@ -81,7 +81,7 @@ void SlipEventDetector::startEvent(double step_start, double dt, const ContactIn
   in_event_ = true;
   const std::size_t n = positions_.size();
   current_ = SlipEvent{};
-  current_.index = static_cast<int>(events_.size());
+  current_.index = tally_.events;
   current_.onset_time = step_start + dt;
   for (int node : began_) current_.onset_time = std::min(current_.onset_time, began_at_[node]);
   current_.onset_shear_force = loads.shearAt(current_.onset_time, step_start, dt);
@@ -182,8 +182,8 @@ bool SlipEventDetector::finishUnfinished(double time, double shear_force, const 
     quiet_since_ = time;
     noteQuietStart(shear_force, u);
   }
+  current_.unfinished = true;
   finish();
-  events_.back().unfinished = true;
   return true;
 }
 
@@ -200,8 +200,32 @@ void SlipEventDetector::finish() {
   for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = quiet_u_[node] - onset_u_[node];
   measureExtent(event, positions_, slider_length_, in_contact_.count());
   measureFronts(event, positions_, fit_nodes_, longitudinal_speed_);
-  if (event.global) ++global_count_;
+  tally_.add(event, slider_length_);
+  if (events_.size() == 2 * kKeptEvents) events_.erase(events_.begin(), events_.begin() + kKeptEvents);
   events_.push_back(std::move(event));
+}
+
+void EventTally::add(const SlipEvent& event, double slider_length) {
+  ++events;
+  last_event_unfinished = event.unfinished;
+  const double numbers[] = {event.onset_time,       event.end_time,       event.onset_shear_force,
+                            event.mean_shear_force, event.rupture_length, event.nucleation_position};
+  hash.mix(numbers, sizeof numbers);
+  hash.mix(event.node_slip.data(), sizeof(double) * event.node_slip.size());
+  const bool before_first_global = global_events == 0;
+  if (event.global) ++global_events;
+  if (!before_first_global) return;
+  if (event.global) {
+    static_friction_macro = event.peakShearRatio();
+    kinetic_friction_macro = event.meanShearRatio();
+  } else if (event.backSlip()) {
+    ++back_slips;
+  } else {
+    ++precursors;
+    if (event.rupture_length == 0.0) ++single_node_precursors;
+    precursor_points.push_back(
+        {event.onset_shear_force / event.onset_normal_force, event.rupture_length / slider_length});
+  }
 }
 
 FitWindow frontFitWindow(int fit_nodes) {

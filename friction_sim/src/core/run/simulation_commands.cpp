@@ -10,7 +10,7 @@ namespace friction {
 
 void Simulation::checkStop() {
   if (finished()) return;  // the first reason stands while a caller steps on past it
-  const bool enough_events = scene_.stop.global_events > 0 && detector_.globalEventCount() >= scene_.stop.global_events;
+  const bool enough_events = scene_.stop.global_events > 0 && globalEventCount() >= scene_.stop.global_events;
   if (enough_events || !(time_ < scene_.stop.time) || !(stage_.travel() < scene_.stop.stage_travel)) {
     recordStopReason(enough_events);
   }
@@ -19,7 +19,7 @@ void Simulation::checkStop() {
 [[gnu::cold]] void Simulation::recordStopReason(bool enough_events) {
   std::ostringstream reason;
   if (enough_events) {
-    reason << "reached " << detector_.globalEventCount() << " global slip event(s)";
+    reason << "reached " << globalEventCount() << " global slip event(s)";
   } else if (time_ >= scene_.stop.time) {
     reason << "reached the time limit of " << scene_.stop.time << " s";
   } else {
@@ -38,9 +38,9 @@ std::string Simulation::setStopCondition(const StopSpec& stop) {
   }
   // A condition already met would end the run on the next step: refused, as a caller who means "now"
   // calls stop.
-  if (stop.global_events > 0 && detector_.globalEventCount() >= stop.global_events) {
-    problem() << "global_events " << stop.global_events << " is already reached (" << detector_.globalEventCount()
-              << " so far); allowed: > " << detector_.globalEventCount() << " (0: not this condition)";
+  if (stop.global_events > 0 && globalEventCount() >= stop.global_events) {
+    problem() << "global_events " << stop.global_events << " is already reached (" << globalEventCount()
+              << " so far); allowed: > " << globalEventCount() << " (0: not this condition)";
   }
   if (!(stop.time > time_)) {
     problem() << "time " << stop.time << " s is not allowed; allowed: > " << time_
