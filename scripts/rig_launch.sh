@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Runs roslaunch with a private master bound to localhost on a free port, so that the rig neither
-# disturbs another ROS system on the machine nor listens on the network.
+# Runs roslaunch with a private master on 127.0.0.1 and a free port, so that the rig disturbs no other
+# ROS system on the machine, in a network of its own that holds only loopback (scripts/loopback_only.sh),
+# so that it listens on no network.
 #   scripts/rig_launch.sh launch/rig.launch [arg:=value]...
 #   scripts/rig_launch.sh friction_sim rig.launch [arg:=value]...   (or any package's launch file)
+#   FRICTION_RIG_NETWORK=host scripts/rig_launch.sh ...   (the machine's network, e.g. for other hosts)
 # The caller's environment stays (their overlay and packages: a launch file may start their own nodes);
 # the rig's workspace is added to it. Output that is not a terminal carries no colour or title codes.
 # Exit status: 0 only if roslaunch and every node it ran ended cleanly. roslaunch itself exits 0 when a
@@ -10,6 +12,22 @@
 # afterwards and a failing node is named, with status 1, so that scripts and sweeps can tell a failed
 # run from a run. 130 when interrupted (Ctrl-C, kill, hang-up), after roslaunch has stopped every node.
 set -euo pipefail
+
+case "${FRICTION_RIG_NETWORK:-private}" in
+  private)
+    # Once through scripts/loopback_only.sh, which runs this script again in the same process.
+    [ "${FRICTION_RIG_NAMESPACE:-}" = "$$" ] ||
+      FRICTION_RIG_NAMESPACE=$$ exec "$(dirname "$0")/loopback_only.sh" bash "$0" "$@"
+    ;;
+  host) echo "rig_launch: FRICTION_RIG_NETWORK=host: the rig's nodes listen on every network interface" >&2 ;;
+  *)
+    echo "rig_launch: FRICTION_RIG_NETWORK: value '$FRICTION_RIG_NETWORK' is not allowed; allowed: private, host" >&2
+    exit 2
+    ;;
+esac
+namespace_entry=""
+[ "${FRICTION_LOOPBACK_NAMESPACE:-}" != "$$" ] || namespace_entry="nsenter --target $$ --user --net --preserve-credentials"
+
 source "$(dirname "$0")/ros_env.sh"
 caller_package_path="${ROS_PACKAGE_PATH:-}"
 set +u; source "$RIG_WS/devel/setup.bash" --extend; set -u
@@ -22,6 +40,7 @@ export ROS_HOME="${ROS_HOME:-$RIG_WS/ros_home}"
 # roslaunch's own, not in blocks when a node ends.
 export ROSCONSOLE_STDOUT_LINE_BUFFERED="${ROSCONSOLE_STDOUT_LINE_BUFFERED:-1}"
 echo "rig_launch: private master at $ROS_MASTER_URI; to reach it from another shell:"
+[ -z "$namespace_entry" ] || echo "  $namespace_entry bash   (the rig's own network: loopback only)"
 echo "  source $RIG_WS/devel/setup.bash; export ROS_MASTER_URI=$ROS_MASTER_URI ROS_IP=127.0.0.1"
 
 # roslaunch runs its nodes in $ROS_HOME: a relative scene, protocol or bag path on the command line is

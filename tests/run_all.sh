@@ -7,13 +7,14 @@ here="$(cd "$(dirname "$0")/.." && pwd)"
 "$here/scripts/build.sh" -j2 || { echo "0 passed, 1 failed"; exit 1; }
 source "$here/scripts/ros_env.sh"
 # The tests talk only to themselves: on loopback they need no resolvable host name (a fresh container
-# or chroot may not list its own in /etc/hosts) and listen on no network, as scripts/rig_launch.sh.
+# or chroot may not list its own in /etc/hosts), and in a network namespace that holds only loopback
+# they listen on no network, as scripts/rig_launch.sh.
 export ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1
 results="$RIG_WS/build/test_results"
 rm -rf "$results"
 # catkin_make run_tests exits 0 even when tests fail: the verdict comes from catkin_test_results.
 # The rviz test draws: the tests run on a virtual screen (Xvfb, software GL).
-xvfb-run -a -s "-screen 0 1400x900x24" \
+"$here/scripts/loopback_only.sh" xvfb-run -a -s "-screen 0 1400x900x24" \
   catkin_make -C "$RIG_WS" --source "$RIG_ROOT" run_tests -j2 >"$RIG_WS/run_tests.log" 2>&1 || {
   tail -n 50 "$RIG_WS/run_tests.log"
   echo "0 passed, 1 failed"

@@ -86,11 +86,30 @@ class SlowRun:
         if self.process.poll() is None:
             self.process.kill()
             self.process.wait()
+        self.reader.join(timeout=10)
+        self.process.stdout.close()
 
 
 def master_uri(first_line):
     """The private master's address, from the first line rig_launch.sh prints."""
     return re.search(r"private master at (\S+);", first_line).group(1)
+
+
+def client(lines, command):
+    """`command` run in the rig's network, as the lines rig_launch.sh printed first say to reach it: through
+    the namespace's entry where it has one."""
+    entry = re.search(r"^  (nsenter .*) bash   \(the rig's own network", "".join(lines[:3]), re.MULTILINE)
+    return (entry.group(1).split() if entry else []) + command
+
+
+def listening(net_directory):
+    """The local address (hex, as the kernel writes it) of every listening TCP socket of a network namespace,
+    from its /proc/<pid>/net."""
+    found = []
+    for table in ("tcp", "tcp6"):
+        with open(os.path.join(net_directory, table)) as handle:
+            found += [row.split()[1] for row in list(handle)[1:] if row.split()[3] == "0A"]
+    return found
 
 
 def launch(*args, cwd=None, env=None, launch_file=(RIG,)):
@@ -163,6 +182,55 @@ class RigLaunchStatusTest(unittest.TestCase):
         for text in said:
             self.assertIn(text, output)
         return output
+
+    def test_the_rig_listens_on_no_network_of_the_machine(self):
+        # roscpp's servers listen on every interface of their network: the rig's network namespace holds
+        # only loopback, and none of them listens in the machine's. Where the system gives no namespace,
+        # the launch says so.
+        machine_before = set(listening("/proc/self/net"))
+        with SlowRun() as run:
+            self.assertIsNotNone(run.simulator, "the simulator did not start")
+            rig = "/proc/%d/net" % run.simulator
+            with open(os.path.join(rig, "dev")) as devices:
+                interfaces = [line.split(":")[0].strip() for line in list(devices)[2:]]
+            in_rig = listening(rig)
+            in_machine = set(listening("/proc/self/net"))
+            namespaced = os.stat("/proc/%d/ns/net" % run.simulator).st_ino != os.stat("/proc/self/ns/net").st_ino
+            run.process.send_signal(signal.SIGTERM)
+            status, output = run.finish()
+        self.assertEqual(status, 130, output)
+        if not namespaced:
+            self.assertIn("WARNING: this system gives no private network namespace", output)
+            return
+        self.assertEqual(interfaces, ["lo"])
+        # The master, rosout, the simulator, the controller and the detector: an XML-RPC server each, and
+        # a TCPROS server per node.
+        self.assertGreaterEqual(len(in_rig), 5, in_rig)
+        self.assertFalse(in_machine - machine_before, "new listening sockets in the machine's network")
+        self.assertIn("nsenter --target %d --user --net --preserve-credentials bash" % run.process.pid, output)
+
+    def test_the_machines_network_is_a_choice_said_aloud_and_a_bad_choice_is_refused(self):
+        env = dict(os.environ, FRICTION_RIG_NETWORK="host")
+        status, output = launch("scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false", env=env)
+        self.assertEqual(status, 0, output)
+        self.assertIn("rig_launch: FRICTION_RIG_NETWORK=host: the rig's nodes listen on every network interface",
+                      output)
+        self.assertNotIn("nsenter", output)
+        self.assertIn("reached 3 global slip event(s)", output)
+        status, output = launch(env=dict(os.environ, FRICTION_RIG_NETWORK="public"))
+        self.assertEqual(status, 2, output)
+        self.assertIn("FRICTION_RIG_NETWORK: value 'public' is not allowed; allowed: private, host", output)
+        # A system that refuses the namespace (here an unshare that always fails): the run goes on, warned.
+        work = tempfile.mkdtemp(prefix="rig_launch_test_")
+        self.addCleanup(shutil.rmtree, work)
+        with open(os.path.join(work, "unshare"), "w") as refusing:
+            refusing.write("#!/bin/sh\nexit 1\n")
+        os.chmod(os.path.join(work, "unshare"), 0o755)
+        env = dict(os.environ, PATH=work + os.pathsep + os.environ["PATH"])
+        status, output = launch("scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false", env=env)
+        self.assertEqual(status, 0, output)
+        self.assertIn("loopback_only: WARNING: this system gives no private network namespace", output)
+        self.assertIn("reached 3 global slip event(s)", output)
 
     def test_a_refused_scene_fails_the_launch_and_names_the_simulator(self):
         self.assert_launch_fails(["overrides:=pusher.height=1"], "/rig/simulator: scene refused",
@@ -257,8 +325,8 @@ class RigLaunchStatusTest(unittest.TestCase):
             self.assertIsNotNone(run.simulator, "the simulator did not start")
             master = master_uri(run.lines[0])
             env = dict(os.environ, ROS_MASTER_URI=master)
-            flood = subprocess.Popen(["/usr/bin/python3", "-c", FLOOD], env=env, stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, text=True)
+            flood = subprocess.Popen(client(run.lines, ["/usr/bin/python3", "-c", FLOOD]), env=env,
+                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
             self.assertEqual(flood.stdout.readline().strip(), "connected")
             os.kill(run.simulator, signal.SIGSTOP)
             flood.stdin.write("go\n")
@@ -267,7 +335,8 @@ class RigLaunchStatusTest(unittest.TestCase):
             threading.Event().wait(1.0)
             os.kill(run.simulator, signal.SIGCONT)
             flood.communicate(timeout=60)
-            state = subprocess.run(["rostopic", "echo", "-n", "1", "/rig/stage_state/commands_dropped"],
+            state = subprocess.run(client(run.lines, ["rostopic", "echo", "-n", "1",
+                                                      "/rig/stage_state/commands_dropped"]),
                                    capture_output=True, text=True, timeout=60, env=env)
             run.process.send_signal(signal.SIGTERM)
             status, output = run.finish()
@@ -283,8 +352,8 @@ class RigLaunchStatusTest(unittest.TestCase):
         with SlowRun() as run:
             self.assertIsNotNone(run.simulator, "the simulator did not start")
             master = master_uri(run.lines[0])
-            measured = subprocess.run(["/usr/bin/python3", "-c", PACING], capture_output=True, text=True, timeout=120,
-                                      env=dict(os.environ, ROS_MASTER_URI=master))
+            measured = subprocess.run(client(run.lines, ["/usr/bin/python3", "-c", PACING]), capture_output=True,
+                                      text=True, timeout=120, env=dict(os.environ, ROS_MASTER_URI=master))
             run.process.send_signal(signal.SIGTERM)
             run.finish()
         self.assertEqual(measured.returncode, 0, measured.stderr)
@@ -311,10 +380,11 @@ class RigLaunchStatusTest(unittest.TestCase):
                                     "wait_for_subscribers:=interface"], stdout=subprocess.PIPE,
                                    stderr=subprocess.STDOUT, text=True)
         self.addCleanup(lambda: process.poll() is None and process.kill())
-        master = master_uri(process.stdout.readline())
+        first_lines = [process.stdout.readline() for _ in range(3)]
+        master = master_uri(first_lines[0])
         threading.Event().wait(3.0)  # the rig is up and waits; a recorder started late
-        seen = subprocess.run(["rostopic", "echo", "-n", "1", "/rig/interface/frame_index"], capture_output=True,
-                              text=True, timeout=60, env=dict(os.environ, ROS_MASTER_URI=master))
+        seen = subprocess.run(client(first_lines, ["rostopic", "echo", "-n", "1", "/rig/interface/frame_index"]),
+                              capture_output=True, text=True, timeout=60, env=dict(os.environ, ROS_MASTER_URI=master))
         output = process.communicate(timeout=120)[0]
         self.assertEqual(process.returncode, 0, output)
         self.assertEqual(seen.stdout.split(), ["0", "---"], seen.stderr)
