@@ -20,9 +20,10 @@ GNU parallel spreads the runs over the local cores (--jobs, default all) and, wi
 (parallel's --sshlogin list, e.g. "2/node1,2/node2,:" where ":" is this machine), over other
 machines reached by ssh (parallel's PARALLEL_SSH environment variable names another ssh command).
 Those machines need this repository built at the same path and rsync; they need not share a file
-system: parallel copies each run's command.sh there and brings its directory back with rsync. Its
-job log makes a rerun skip the runs that finished and retry the ones that failed; a failed run is
-reported and the others' results are kept. The runs' event tables are collected into
+system: parallel copies each run's command.sh there and brings its directory back with rsync. A
+rerun skips the runs that finished (they wrote their summary.txt), also after values were added to the
+sweep, and retries the others; DIR/joblog.txt keeps every attempt. A failed run is reported and the
+others' results are kept. The runs' event tables are collected into
 DIR/events.csv with one column per varied parameter (DIR defaults to sweeps/<sweep file name>).
 """
 import argparse
@@ -92,7 +93,12 @@ def run(path, jobs=None, hosts=None, out=None):
         with open(os.path.join(run_dir, "command.sh"), "w") as handle:
             handle.write("#!/bin/sh\nexec %s\n" % command(spec, point, run_dir))
         run_dirs.append(run_dir)
-    args = ["parallel", "--joblog", os.path.join(out, "joblog.txt"), "--resume-failed", "--halt", "never"]
+    # A run is done once it has written its summary: only the others go to parallel (its own resume goes
+    # by the jobs' order, which a value added to the sweep shifts). Its job log keeps every attempt.
+    to_run = [d for d in run_dirs if not os.path.exists(os.path.join(d, "summary.txt"))]
+    if not to_run:
+        return collect(spec, points, out)
+    args = ["parallel", "--joblog", "+" + os.path.join(out, "joblog.txt"), "--halt", "never"]
     if jobs:
         args += ["--jobs", str(jobs)]
     if hosts:
@@ -102,7 +108,7 @@ def run(path, jobs=None, hosts=None, out=None):
     # them again (a run named "normal_force=1000" comes back as "'./normal_force=1000'") unless told
     # to pass them as they are.
     environment = dict(os.environ, RSYNC_OLD_ARGS="1")
-    subprocess.run(args + ["sh {}/command.sh"], input="\n".join(run_dirs) + "\n", text=True, env=environment)
+    subprocess.run(args + ["sh {}/command.sh"], input="\n".join(to_run) + "\n", text=True, env=environment)
     return collect(spec, points, out)
 
 

@@ -95,9 +95,24 @@ class SweepTest(unittest.TestCase):
         self.assertEqual(failed, ["normal_force=-5"])
         self.assert_onsets_follow_amontons(rows, [1000.0])
         with open(os.path.join(out, "joblog.txt")) as handle:
-            commands = [line.split("\t")[-1] for line in handle.read().splitlines()[1:]]
+            commands = [line.split("\t")[-1] for line in handle.read().splitlines() if not line.startswith("Seq")]
         self.assertEqual(sum("normal_force=1000" in c for c in commands), 1)
         self.assertEqual(sum("normal_force=-5" in c for c in commands), 2)
+
+    def test_a_value_added_to_the_sweep_runs_alone(self):
+        # The runs that finished are kept, whatever their place in the new list.
+        out = os.path.join(self.work, "out")
+        sweep.run(self.write_sweep("[1000, 3000]"), jobs=1, out=out)
+        summaries = {force: os.path.join(out, "runs", "normal_force=%d" % force, "summary.txt") for force in (1000, 3000)}
+        finished = {force: os.stat(path).st_mtime_ns for force, path in summaries.items()}
+        rows, failed = sweep.run(self.write_sweep("[1000, 2000, 3000]"), jobs=1, out=out)
+        self.assertEqual(failed, [])
+        self.assertEqual({force: os.stat(path).st_mtime_ns for force, path in summaries.items()}, finished)
+        self.assert_onsets_follow_amontons(rows, [1000.0, 2000.0, 3000.0])
+        with open(os.path.join(out, "joblog.txt")) as handle:
+            commands = [line.split("\t")[-1] for line in handle.read().splitlines() if not line.startswith("Seq")]
+        self.assertEqual([sum("normal_force=%d" % force in c for c in commands) for force in (1000, 2000, 3000)],
+                         [1, 1, 1])
 
     def write_ssh_stand_in(self, run_on_host):
         """An ssh that runs the command here, through run_on_host (a shell line given $HOST and the
