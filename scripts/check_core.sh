@@ -8,7 +8,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 build="${1:-$root/.build/core-sanitize}"
 # Only the system's tools: no /opt/ros, no pyenv.
 export PATH=/usr/bin:/bin
-# Under the sanitizers the cases run about ten times slower than in Release. The twenty-four longest
+# Under the sanitizers the cases run about ten times slower than in Release. The twenty-five longest
 # (4.5 to 38 s each, most of the sanitized run) repeat at larger sizes or over longer runs what others
 # test; the Release build runs them all.
 slow=(
@@ -28,6 +28,7 @@ slow=(
   FastForward.StaticJumpAgreesWithALongDampedDynamicRelaxation
   FastForward.AgreesWithFullDynamicsOnPrecursorsAndFirstGlobalEvent
   SlipEvents.AnInterfaceThatCreepsGivesWayAtItsPeakForceNotAtItsFirstUnsticking
+  RateStateResults.TheFilesHoldEachContactsAgeingStrengthAndWhenEachNodeLastSlipped
   SlipWeakening.EnergyBudgetClosesToRoundOffForASingleBlockAndClosely2D
   BothIntegratorsBothDirections/SingleBlockStickSlip.MatchesTheClosedFormCycle/2
   BothIntegratorsBothDirections/SingleBlockStickSlip.MatchesTheClosedFormCycle/3

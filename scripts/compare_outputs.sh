@@ -30,11 +30,11 @@ cases=(
   "2d_mattress|pmma_2d.yaml|load.top=spring_mattress"
   "2d_wide|pmma_2d.yaml|lattice.nodes_x=281 lattice.nodes_z=16 geometry.height=0.0075 integrator.time_step=4e-8 stop.time=0.2"
   "1d_side|pmma_1d_side.yaml|"
-  "1d_side_ff|pmma_1d_side.yaml|integrator.fast_forward=true"
+  "1d_side_verlet|pmma_1d_side.yaml|integrator.scheme=velocity_verlet integrator.time_step=2e-7 integrator.fast_forward=false"
   "1d_top|pmma_1d_top.yaml|"
   "1d_tilt|pmma_1d_side.yaml|chain.tilt=0.3"
   "1d_torque|pmma_1d_side.yaml|chain.torque_share=1.0"
-  "1d_sw|pmma_1d_side.yaml|friction.law=slip_weakening friction.weakening_length=1e-7"
+  "1d_sw|pmma_1d_side.yaml|friction.law=slip_weakening friction.weakening_length=1e-7 integrator.scheme=velocity_verlet integrator.time_step=2e-7"
   "block|single_block.yaml|"
 )
 

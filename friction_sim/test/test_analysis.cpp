@@ -379,7 +379,7 @@ void expectTheSameEventsAndExtents(const std::vector<SlipEvent>& found, const st
 }
 
 TEST(FrameEventDetector, FindsTheSimulatorsEventsFromTheInstrumentsAlone) {
-  Simulation simulation(loadScene(testing::scenePath("pmma_1d_side")));
+  Simulation simulation(testing::coarseSideChainScene());
   FrameEventDetector detector(simulation.scene().instruments.front_fit_nodes,
                               waveSpeeds(simulation.scene()).longitudinal);
   const std::vector<SlipEvent> found = eventsSeenByTheInstruments(simulation, detector);
@@ -460,7 +460,7 @@ TEST(SlipEvents, AnInterfaceThatCreepsGivesWayAtItsPeakForceNotAtItsFirstUnstick
   // the weakening, (µ_s − µ_k)·w/ξ_µ ≈ 7.7e5 N/m): the first block unsticks at F_X = µ_s·F_Z/57 and the
   // chain creeps on, taking load, in one event. Its peak is the largest F_X the load cell reads until
   // the last block has slipped.
-  Scene scene = loadScene(testing::scenePath("pmma_1d_side"));
+  Scene scene = testing::coarseSideChainScene();
   scene.friction.law = FrictionLawKind::SlipWeakening;
   scene.friction.weakening_length = 1e-5;
   Simulation simulation(scene);
@@ -563,7 +563,7 @@ TEST(FrameEventDetector, AnEventWaitingForItsLastReadingIsGivenWhenTheStreamRest
 
 TEST(FrameEventDetector, StuckNodesMovingOnTheirInterfacialSpringsDidNotSlip) {
   // With k_T every stuck node moves a little as the load changes; only the nodes seen sliding slipped.
-  Scene scene = loadScene(testing::scenePath("pmma_1d_side"));
+  Scene scene = testing::coarseSideChainScene();
   scene.friction.interfacial_stiffness = 1.0e8;
   Simulation simulation(scene);
   FrameEventDetector detector(scene.instruments.front_fit_nodes, waveSpeeds(scene).longitudinal);

@@ -44,6 +44,18 @@ inline Scene coarseSliderScene(bool fast_forward = false) {
   return scene;
 }
 
+/// pmma_1d_side stepped as it was before its default became converged: velocity Verlet at 0.2 µs, full
+/// dynamics. Its first 28 precursor onsets are within 1e-3 of the converged ones
+/// (docs/benchmarks/chain_time_step.md), and it runs fast enough to be stepped one step at a time: for
+/// the tests of the instruments and of the force balance, whose tolerances were measured on it.
+inline Scene coarseSideChainScene() {
+  Scene scene = loadScene(scenePath("pmma_1d_side"));
+  scene.integrator.scheme = IntegratorKind::VelocityVerlet;
+  scene.integrator.time_step = 2e-7;
+  scene.integrator.fast_forward = false;
+  return scene;
+}
+
 /// A chain of `blocks` blocks driven at the side 5 mm up with the whole torque term, so that every
 /// normal force depends on F_X.
 inline Scene torqueChainScene(int blocks) {

@@ -168,7 +168,7 @@ class SideDrivenChainUnderNonUniformLoad : public ::testing::TestWithParam<NonUn
 // line in F_X/F_Z that λ itself is under a uniform load.
 TEST_P(SideDrivenChainUnderNonUniformLoad, ArrestFrontsFollowTheForceBalanceWithTheLoadsSlope) {
   const NonUniformLoad load = GetParam();
-  Scene scene = loadScene(scenePath("pmma_1d_side"));
+  Scene scene = testing::coarseSideChainScene();
   scene.chain.tilt = load.tilt;
   scene.chain.torque_share = load.torque_share;
   scene.pusher.height = load.height;
