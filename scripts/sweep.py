@@ -103,7 +103,8 @@ def run(path, jobs=None, hosts=None, out=None):
         args += ["--jobs", str(jobs)]
     if hosts:
         # Absolute paths: rsync puts command.sh at the same path there and the run's directory back here.
-        args += ["--sshlogin", hosts, "--transferfile", "{}/command.sh", "--return", "{}"]
+        # A run whose host fails (its ssh connection drops) is retried on another host.
+        args += ["--sshlogin", hosts, "--transferfile", "{}/command.sh", "--return", "{}", "--retries", "3"]
     # parallel quotes the paths it hands rsync for the remote shell; rsync 3.2.4 and later would quote
     # them again (a run named "normal_force=1000" comes back as "'./normal_force=1000'") unless told
     # to pass them as they are.
