@@ -28,14 +28,15 @@ def nucleation_length(normal_force):
     return shear_modulus * _LAW["characteristic_slip"] / (_LAW["ageing_effect"] * _LAW["reference_coefficient"] * sigma)
 
 
-def event_nodes(sweep_name, run):
-    """event index → [(x (m), front speed (m/s), peak slip velocity (m/s))] of the nodes with a front speed."""
+def event_nodes(sweep_name, run, columns=("front_speed_m_s", "peak_slip_velocity_m_s")):
+    """event index → [(x (m), then each of `columns`)] of a run's event_nodes.csv, for the nodes whose first
+    column is finite (by default: the nodes with a front speed, with their peak slip velocity)."""
     out = {}
     with open(os.path.join(sweep.ROOT, "sweeps", sweep_name, "runs", run, "event_nodes.csv")) as handle:
         for r in csv.DictReader(handle):
-            speed = float(r["front_speed_m_s"])
-            if math.isfinite(speed):
-                out.setdefault(r["event"], []).append((float(r["x_m"]), speed, float(r["peak_slip_velocity_m_s"])))
+            values = [float(r[column]) for column in columns]
+            if math.isfinite(values[0]):
+                out.setdefault(r["event"], []).append(tuple([float(r["x_m"])] + values))
     return out
 
 
@@ -92,17 +93,6 @@ def mean_ratio(profile, low, high, column=1):
     """The mean of `column` of `profile` (onset_prestress) over low <= x < high (m), or nan."""
     values = [point[column] for point in profile if low <= point[0] < high]
     return sum(values) / len(values) if values else float("nan")
-
-
-def slip_times(sweep_name, run):
-    """event index → [(x (m), first-unstick time (s), last-slip time (s))] of the nodes that slipped."""
-    out = {}
-    with open(os.path.join(sweep.ROOT, "sweeps", sweep_name, "runs", run, "event_nodes.csv")) as handle:
-        for r in csv.DictReader(handle):
-            first = float(r["first_unstick_time_s"])
-            if math.isfinite(first):
-                out.setdefault(r["event"], []).append((float(r["x_m"]), first, float(r["last_slip_time_s"])))
-    return out
 
 
 def still_slipping_behind(times, turn_x, slow_end_x):
@@ -202,7 +192,7 @@ def sections(data):
     # The prestress τ/σ at the event's onset, and τ/(µ_s·σ), where the front ran fast (the three nodes before
     # it turned) and where it ran slow; and whether the slip behind still ran while the front ran slow.
     prestress = onset_prestress("rate_state_normal_load", DEFAULT_RUN)
-    times = slip_times("rate_state_normal_load", DEFAULT_RUN)
+    times = event_nodes("rate_state_normal_load", DEFAULT_RUN, ("first_unstick_time_s", "last_slip_time_s"))
     spacing = float(_SCENE["geometry"]["length"]) / (int(_SCENE["lattice"]["nodes_x"]) - 1)
     rows = []
     for i, (turn, run_slow) in transitions:
