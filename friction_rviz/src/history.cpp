@@ -17,21 +17,13 @@ bool SeriesHistory::add(double time, double value) {
   return jumped;
 }
 
-EventKind eventKind(bool global_event, double rupture_length, bool after_a_global_event, bool back_slip) {
-  if (global_event) return EventKind::Global;
-  if (after_a_global_event) return EventKind::AfterGlobal;
-  if (back_slip) return EventKind::BackSlip;
-  return rupture_length == 0.0 ? EventKind::SingleNodeSlip : EventKind::Precursor;
-}
-
 void PrecursorScatter::add(double onset_shear_force, double onset_normal_force, double rupture_length,
-                           double slider_length, bool global_event, bool back_slip) {
-  const EventKind kind = eventKind(global_event, rupture_length, seen_global_, back_slip);
-  seen_global_ = seen_global_ || global_event;
+                           double slider_length, int kind) {
   const double shear_ratio = onset_shear_force / onset_normal_force;
   const double length_ratio = rupture_length / slider_length;
+  if (kind < 0 || kind >= static_cast<int>(points_.size())) return;
   if (!std::isfinite(shear_ratio) || !std::isfinite(length_ratio)) return;
-  Points& points = points_[static_cast<int>(kind)];
+  Points& points = points_[kind];
   points.shear_ratio.push_back(shear_ratio);
   points.length_ratio.push_back(length_ratio);
 }

@@ -189,8 +189,7 @@ void RigPanel::onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr& msg) {
 }
 
 void RigPanel::onEvent(const friction_msgs::SlipEvent::ConstPtr& msg) {
-  events_.add(msg->onset_shear_force, msg->onset_normal_force, msg->rupture_length, msg->slider_length,
-              msg->global_event, msg->mean_slip < 0.0);
+  events_.add(msg->onset_shear_force, msg->onset_normal_force, msg->rupture_length, msg->slider_length, msg->kind);
 }
 
 void RigPanel::onStageState(const friction_msgs::StageState::ConstPtr& msg) { last_state_ = *msg; }

@@ -60,6 +60,14 @@ TEST(Conversions, InterfaceFrameRoundTrips) {
   EXPECT_EQ(back.static_coefficient, frame.static_coefficient);
 }
 
+TEST(Conversions, SlipEventKindsAreNumberedAsTheMessagesConstants) {
+  EXPECT_EQ(static_cast<int>(SlipEventKind::Precursor), friction_msgs::SlipEvent::PRECURSOR);
+  EXPECT_EQ(static_cast<int>(SlipEventKind::SingleNodeSlip), friction_msgs::SlipEvent::SINGLE_NODE_SLIP);
+  EXPECT_EQ(static_cast<int>(SlipEventKind::BackSlip), friction_msgs::SlipEvent::BACK_SLIP);
+  EXPECT_EQ(static_cast<int>(SlipEventKind::Global), friction_msgs::SlipEvent::GLOBAL);
+  EXPECT_EQ(static_cast<int>(SlipEventKind::AfterGlobal), friction_msgs::SlipEvent::AFTER_GLOBAL);
+}
+
 TEST(Conversions, SlipEventCarriesEveryQuantity) {
   SlipEvent event;
   event.index = 3;
@@ -75,6 +83,7 @@ TEST(Conversions, SlipEventCarriesEveryQuantity) {
   event.slip_max_x = 0.05;
   event.rupture_length = 0.05;
   event.global = false;
+  event.kind = SlipEventKind::AfterGlobal;
   event.node_slip = {1e-6, 5e-7, 0.0};
   event.first_unstick_time = {0.1, 0.10001, std::nan("")};
   event.front_speed = {250.0, 250.0, std::nan("")};
@@ -93,6 +102,8 @@ TEST(Conversions, SlipEventCarriesEveryQuantity) {
   EXPECT_DOUBLE_EQ(back.mean_shear_force, 180.0);
   EXPECT_DOUBLE_EQ(back.mean_normal_force, 1921.0);
   EXPECT_DOUBLE_EQ(back.rupture_length, 0.05);
+  EXPECT_EQ(msg.kind, friction_msgs::SlipEvent::AFTER_GLOBAL);
+  EXPECT_EQ(back.kind, SlipEventKind::AfterGlobal);
   EXPECT_EQ(back.node_slip, event.node_slip);
   EXPECT_TRUE(std::isnan(back.first_unstick_time[2]));
   EXPECT_DOUBLE_EQ(back.median_front_speed, 250.0);

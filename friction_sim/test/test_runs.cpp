@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "friction_sim/instruments/results_io.h"
@@ -371,6 +372,41 @@ TEST(EventTally, TenThousandEventsAreAllCountedAndOnlyTheLatestKept) {
   // the stage a metre on).
   const double drop = 2.0 * (mu_s - mu_k) * scene.load.normal_force;
   EXPECT_NEAR(kept.back().onset_shear_force - kept.back().end_shear_force, drop, 1e-5 * drop);
+}
+
+TEST(EventTally, EachEventIsClassifiedAndTheSummaryCountsTheKinds) {
+  // The default slider through three stick–slip cycles: precursors (some of one node) before the first
+  // global event, then global events and the arrested ones between them.
+  Scene scene = loadScene(scenePath("pmma_2d"));
+  scene.stop.global_events = 3;
+  Simulation simulation(scene);
+  simulation.run();
+  const std::vector<SlipEvent>& events = simulation.events();
+  std::map<SlipEventKind, int> count;
+  bool after_global = false;
+  for (const SlipEvent& event : events) {
+    SCOPED_TRACE("event " + std::to_string(event.index));
+    const SlipEventKind expected = event.global                  ? SlipEventKind::Global
+                                   : after_global                ? SlipEventKind::AfterGlobal
+                                   : event.backSlip()            ? SlipEventKind::BackSlip
+                                   : event.rupture_length == 0.0 ? SlipEventKind::SingleNodeSlip
+                                                                 : SlipEventKind::Precursor;
+    EXPECT_EQ(event.kind, expected);
+    after_global = after_global || event.global;
+    ++count[event.kind];
+  }
+  // As friction_run prints them: events 0–5 before the first global one (1 and 3 of one node), 7 and 9
+  // arrested between the global events 6, 8 and 10.
+  EXPECT_EQ(count[SlipEventKind::Precursor], 4);
+  EXPECT_EQ(count[SlipEventKind::SingleNodeSlip], 2);
+  EXPECT_EQ(count[SlipEventKind::BackSlip], 0);
+  EXPECT_EQ(count[SlipEventKind::Global], 3);
+  EXPECT_EQ(count[SlipEventKind::AfterGlobal], 2);
+  const EventTally& tally = simulation.eventTally();
+  EXPECT_EQ(tally.precursors, count[SlipEventKind::Precursor] + count[SlipEventKind::SingleNodeSlip]);
+  EXPECT_EQ(tally.single_node_precursors, count[SlipEventKind::SingleNodeSlip]);
+  EXPECT_EQ(tally.back_slips, count[SlipEventKind::BackSlip]);
+  EXPECT_EQ(tally.global_events, 3);
 }
 
 TEST(Determinism, SameSceneTwiceGivesIdenticalEventsAndState) {

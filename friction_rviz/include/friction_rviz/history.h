@@ -28,34 +28,25 @@ class SeriesHistory {
   std::deque<double> times_, values_;
 };
 
-/// The kinds of slip event the panel's L_p/L against F_X/F_Z plot tells apart.
-enum class EventKind { Precursor = 0, SingleNodeSlip = 1, AfterGlobal = 2, Global = 3, BackSlip = 4 };
-/// A global event ran over the whole interface. The others before the first global event are precursors,
-/// and those with L_p = 0 single nodes slipping alone (no front ran), as the runner's summary
-/// (results_io.cpp) and rig_report count them, except the back-slips, in which the interface slid against
-/// x (SlipEvent.mean_slip < 0: where the stage draws back, or beside a trailing corner that lifts off);
-/// those after it arrested in a later
-/// stick–slip cycle, on an interface the global slip has left stressed differently.
-EventKind eventKind(bool global_event, double rupture_length, bool after_a_global_event, bool back_slip);
+/// The kinds of slip event the panel's L_p/L against F_X/F_Z plot tells apart, numbered as
+/// friction_msgs/SlipEvent's `kind` constants: the simulator classifies each event (friction_sim's
+/// classifySlipEvent), the panel only draws it.
+enum class EventKind { Precursor = 0, SingleNodeSlip = 1, BackSlip = 2, Global = 3, AfterGlobal = 4 };
 
-/// The points of the precursor plot, (F_X/F_Z at onset, L_p/L), by kind; events are added in order.
+/// The points of the precursor plot, (F_X/F_Z at onset, L_p/L), by kind.
 class PrecursorScatter {
  public:
   struct Points {
     std::vector<double> shear_ratio, length_ratio;
   };
-  /// Forces in N, lengths in m. An event whose ratios are not finite (F_Z or L zero) adds no point.
-  void add(double onset_shear_force, double onset_normal_force, double rupture_length, double slider_length,
-           bool global_event, bool back_slip);
-  void clear() {
-    points_ = {};
-    seen_global_ = false;
-  }
+  /// Forces in N, lengths in m, `kind` a SlipEvent message's. An event whose ratios are not finite (F_Z or
+  /// L zero), or whose kind is none of EventKind's, adds no point.
+  void add(double onset_shear_force, double onset_normal_force, double rupture_length, double slider_length, int kind);
+  void clear() { points_ = {}; }
   const Points& points(EventKind kind) const { return points_[static_cast<int>(kind)]; }
 
  private:
   std::array<Points, 5> points_;
-  bool seen_global_ = false;
 };
 
 /// A slip event as the space–time strip outlines it.

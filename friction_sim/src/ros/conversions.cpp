@@ -94,6 +94,7 @@ friction_msgs::SlipEvent toMsg(const SlipEvent& event, const std::vector<double>
   msg.rupture_length = event.rupture_length;
   msg.slider_length = slider_length;
   msg.global_event = event.global;
+  msg.kind = static_cast<std::uint8_t>(event.kind);
   msg.unfinished = event.unfinished;
   msg.mean_slip = event.meanSlip();
   msg.position = positions;
@@ -124,6 +125,7 @@ SlipEvent fromMsg(const friction_msgs::SlipEvent& msg) {
   event.slip_max_x = msg.slip_max_x;
   event.rupture_length = msg.rupture_length;
   event.global = msg.global_event;
+  event.kind = static_cast<SlipEventKind>(msg.kind);
   event.unfinished = msg.unfinished;
   event.node_slip = msg.node_slip;
   event.first_unstick_time = msg.first_unstick_time;

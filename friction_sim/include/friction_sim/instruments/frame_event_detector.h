@@ -54,6 +54,7 @@ class FrameEventDetector {
   std::optional<InterfaceFrame> last_stuck_frame_;
   std::optional<InterfaceFrame> quiet_frame_;  ///< the first of the current event's frames with no node slipping
   bool in_event_ = false;
+  bool seen_global_ = false;  ///< a global event has ended: the later non-global ones come after it
   SlipEvent current_;
   ContactDuringEvent in_contact_;  ///< of the current event
   std::deque<SlipEvent> ended_;    ///< waiting for their load cells

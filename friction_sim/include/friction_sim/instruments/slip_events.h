@@ -14,13 +14,23 @@
 
 namespace friction {
 
+/// What an event was (MODEL.md §6), as friction_msgs/SlipEvent's `kind` constants number them.
+enum class SlipEventKind : std::uint8_t {
+  Precursor = 0,       ///< before the first global event, a front that arrested (L_p > 0), slid forward
+  SingleNodeSlip = 1,  ///< before the first global event, one node alone (L_p = 0): no front ran
+  BackSlip = 2,        ///< before the first global event, the interface slid back, against x
+  Global = 3,          ///< every node in contact slipped
+  AfterGlobal = 4,     ///< not global, after the first global event: in a later stick–slip cycle
+};
+
 struct SlipEvent {
-  int index = 0;                    ///< 0-based order of the event in the run
-  double onset_time = 0.0;          ///< s, first threshold crossing, interpolated within the step
-  double end_time = 0.0;            ///< s, last re-stick, interpolated within the step
-  double onset_shear_force = 0.0;   ///< N, F_X at onset (interpolated within the step)
-  double onset_normal_force = 0.0;  ///< N, F_Z at onset
-  double end_shear_force = 0.0;     ///< N, F_X at the end (interpolated within the step)
+  int index = 0;                                  ///< 0-based order of the event in the run
+  SlipEventKind kind = SlipEventKind::Precursor;  ///< classifySlipEvent's, set by the detector
+  double onset_time = 0.0;                        ///< s, first threshold crossing, interpolated within the step
+  double end_time = 0.0;                          ///< s, last re-stick, interpolated within the step
+  double onset_shear_force = 0.0;                 ///< N, F_X at onset (interpolated within the step)
+  double onset_normal_force = 0.0;                ///< N, F_Z at onset
+  double end_shear_force = 0.0;                   ///< N, F_X at the end (interpolated within the step)
   /// N, the F_X of largest magnitude from the onset until every interface node in contact has slipped (until the
   /// end if they never all do): the load the interface bore while it gave way. For a dynamic event it is
   /// the onset's, as F_X drops while the front runs; an interface that creeps (slip weakening with a
@@ -62,6 +72,10 @@ struct SlipEvent {
   /// sliding, whatever its extent (a global one is a global event, slid back as a whole).
   bool backSlip() const { return meanSlip() < 0.0; }
 };
+
+/// The kind of a finished `event` (its extent and slips measured), given whether a global event came
+/// before it in the run. The one rule behind the summary's counts, the messages and the plots.
+SlipEventKind classifySlipEvent(const SlipEvent& event, bool after_a_global_event);
 
 /// FNV-1a over bytes: the run's state hash (Simulation::stateHash), its events' included.
 class StateHash {

@@ -20,6 +20,7 @@ void FrameEventDetector::reset() {
   last_stuck_frame_.reset();
   quiet_frame_.reset();
   in_event_ = false;
+  seen_global_ = false;
   ended_.clear();
   last_frame_time_ = -std::numeric_limits<double>::infinity();
 }
@@ -140,6 +141,8 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   // nodes move elastically, and detached nodes move freely.
   measureExtent(event, frame.position, sliderLength(), in_contact_.count());
   measureFronts(event, frame.position, front_fit_nodes_, longitudinal_speed_);
+  event.kind = classifySlipEvent(event, seen_global_);
+  seen_global_ = seen_global_ || event.global;
   last_stuck_frame_ = frame;
   quiet_frame_.reset();
   ended_.push_back(std::move(event));

@@ -200,6 +200,7 @@ void SlipEventDetector::finish() {
   for (std::size_t node = 0; node < n; ++node) event.node_slip[node] = quiet_u_[node] - onset_u_[node];
   measureExtent(event, positions_, slider_length_, in_contact_.count());
   measureFronts(event, positions_, fit_nodes_, longitudinal_speed_);
+  event.kind = classifySlipEvent(event, tally_.global_events > 0);
   tally_.add(event, slider_length_);
   if (events_.size() == 2 * kKeptEvents) events_.erase(events_.begin(), events_.begin() + kKeptEvents);
   events_.push_back(std::move(event));
@@ -212,20 +213,35 @@ void EventTally::add(const SlipEvent& event, double slider_length) {
                             event.mean_shear_force, event.rupture_length, event.nucleation_position};
   hash.mix(numbers, sizeof numbers);
   hash.mix(event.node_slip.data(), sizeof(double) * event.node_slip.size());
-  const bool before_first_global = global_events == 0;
-  if (event.global) ++global_events;
-  if (!before_first_global) return;
-  if (event.global) {
-    static_friction_macro = event.peakShearRatio();
-    kinetic_friction_macro = event.meanShearRatio();
-  } else if (event.backSlip()) {
-    ++back_slips;
-  } else {
-    ++precursors;
-    if (event.rupture_length == 0.0) ++single_node_precursors;
-    precursor_points.push_back(
-        {event.onset_shear_force / event.onset_normal_force, event.rupture_length / slider_length});
+  const bool first_global = event.kind == SlipEventKind::Global && global_events == 0;
+  if (event.kind == SlipEventKind::Global) ++global_events;
+  switch (event.kind) {
+    case SlipEventKind::Global:
+      if (first_global) {
+        static_friction_macro = event.peakShearRatio();
+        kinetic_friction_macro = event.meanShearRatio();
+      }
+      break;
+    case SlipEventKind::BackSlip:
+      ++back_slips;
+      break;
+    case SlipEventKind::SingleNodeSlip:
+    case SlipEventKind::Precursor:
+      ++precursors;
+      if (event.kind == SlipEventKind::SingleNodeSlip) ++single_node_precursors;
+      precursor_points.push_back(
+          {event.onset_shear_force / event.onset_normal_force, event.rupture_length / slider_length});
+      break;
+    case SlipEventKind::AfterGlobal:
+      break;
   }
+}
+
+SlipEventKind classifySlipEvent(const SlipEvent& event, bool after_a_global_event) {
+  if (event.global) return SlipEventKind::Global;
+  if (after_a_global_event) return SlipEventKind::AfterGlobal;
+  if (event.backSlip()) return SlipEventKind::BackSlip;
+  return event.rupture_length == 0.0 ? SlipEventKind::SingleNodeSlip : SlipEventKind::Precursor;
 }
 
 FitWindow frontFitWindow(int fit_nodes) {
