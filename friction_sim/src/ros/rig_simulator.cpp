@@ -263,8 +263,11 @@ void RigSimulator::addStreams(RunDriver& driver) {
 
 void RigSimulator::advertise() {
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 100);
-  load_cells_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("load_cells", 1000);
-  gauges_pub_ = nh_.advertise<friction_msgs::StrainGaugeProfile>("strain_gauges", 1000);
+  // Deep queues: an unpaced jump publishes all its interpolated samples at once (a 0.1 s jump, 10³ load
+  // cells), and a full queue drops the oldest, which a subscriber busy elsewhere then never sees. At most
+  // about 10 MB each (a gauge profile is some 1.5 kB, a load cell reading 0.1 kB).
+  load_cells_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("load_cells", 100000);
+  gauges_pub_ = nh_.advertise<friction_msgs::StrainGaugeProfile>("strain_gauges", 10000);
   interface_pub_ = nh_.advertise<friction_msgs::InterfaceState>("interface", 10000);
   events_pub_ = nh_.advertise<friction_msgs::SlipEvent>("slip_events", 1000, true);
   lattice_pub_ = nh_.advertise<friction_msgs::LatticeSnapshot>("lattice", 2);
