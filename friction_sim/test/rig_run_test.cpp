@@ -25,6 +25,10 @@
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -83,6 +87,29 @@ int runCommand(const std::string& command, std::string& output) {
   const int status = pclose(pipe);
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
+
+/// A shell command run in the background for the object's lifetime; interrupted (SIGINT) at its end.
+class BackgroundCommand {
+ public:
+  explicit BackgroundCommand(const std::string& command) {
+    const std::string exec_command = "exec " + command + " >/dev/null 2>&1";
+    pid_ = fork();
+    if (pid_ == 0) {
+      execl("/bin/sh", "sh", "-c", exec_command.c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+  }
+  BackgroundCommand(const BackgroundCommand&) = delete;
+  BackgroundCommand& operator=(const BackgroundCommand&) = delete;
+  ~BackgroundCommand() {
+    if (pid_ <= 0) return;
+    kill(pid_, SIGINT);
+    waitpid(pid_, nullptr, 0);
+  }
+
+ private:
+  pid_t pid_;
+};
 
 /// The whole text of a file ("" if it cannot be read).
 std::string readFile(const std::string& path) {
@@ -665,13 +692,14 @@ void watchFullRun(ros::NodeHandle& nh) {
   waitFor([] { return bagReadable(g_bag); }, 240.0);
   waitFor([] { return g_seen.live_points.size() >= g_seen.events.size(); }, 10.0);
   // Replay the bag into the second detector, under its own names, once it listens: on a loaded machine
-  // a fixed delay let the first frames go by before it had connected, and with them an event.
-  std::string output;
-  runCommand("rosbag play --quiet --wait-for-subscribers -r 10 --queue 1000000 " + g_bag +
-                 " --topics /rig/scene /rig/load_cells /rig/interface /rig/scene:=/replay/scene"
-                 " /rig/load_cells:=/replay/load_cells /rig/interface:=/replay/interface",
-             output);
-  waitFor([] { return g_seen.replay_points.size() >= g_seen.events.size(); }, 30.0);
+  // a fixed delay let the first frames go by before it had connected, and with them an event. The
+  // player stays alive until the detector has caught up: a player that exits drops what its queues
+  // still hold, and at ten times the pace that is most of the bag.
+  const BackgroundCommand player("rosbag play --quiet --keep-alive --wait-for-subscribers -r 10 --queue 1000000 " +
+                                 g_bag +
+                                 " --topics /rig/scene /rig/load_cells /rig/interface /rig/scene:=/replay/scene"
+                                 " /rig/load_cells:=/replay/load_cells /rig/interface:=/replay/interface");
+  waitFor([] { return g_seen.replay_points.size() >= g_seen.events.size(); }, 120.0);
 }
 
 void watchKilledRun(ros::NodeHandle& nh) {
