@@ -6,7 +6,7 @@
 set -euo pipefail
 
 common=(build-essential cmake libeigen3-dev libsuitesparse-dev libyaml-cpp-dev libgtest-dev googletest libbenchmark-dev parallel rsync
-        python3-matplotlib python3-numpy python3-yaml xvfb xauth imagemagick libgl1-mesa-dri)
+        python3-matplotlib python3-numpy python3-yaml python3-setuptools xvfb xauth imagemagick libgl1-mesa-dri)
 if [ -d /opt/ros/noetic ]; then
   ros=(ros-noetic-catkin ros-noetic-roscpp ros-noetic-rosbag ros-noetic-rostest ros-noetic-roslaunch
        ros-noetic-std-msgs ros-noetic-geometry-msgs ros-noetic-visualization-msgs ros-noetic-rosgraph-msgs
