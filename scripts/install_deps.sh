@@ -11,13 +11,13 @@ if [ -d /opt/ros/noetic ]; then
   ros=(ros-noetic-catkin ros-noetic-roscpp ros-noetic-rosbag ros-noetic-rostest ros-noetic-roslaunch
        ros-noetic-std-msgs ros-noetic-geometry-msgs ros-noetic-visualization-msgs ros-noetic-rosgraph-msgs
        ros-noetic-std-srvs ros-noetic-rosnode ros-noetic-message-generation ros-noetic-message-runtime
-       ros-noetic-rviz ros-noetic-tf2-ros ros-noetic-pluginlib ros-noetic-rospy python3-catkin-pkg python3-catkin-lint)
+       ros-noetic-rviz ros-noetic-dynamic-reconfigure ros-noetic-tf2-ros ros-noetic-pluginlib ros-noetic-rospy python3-catkin-pkg python3-catkin-lint)
 else
   ros=(catkin python3-catkin-pkg ros-core-dev librosbag-dev python3-rosbag python3-rospy python3-rostest
        python3-roslaunch python3-rosnode rosbash ros-message-generation libstd-msgs-dev libstd-srvs-dev
        python3-std-srvs python3-geometry-msgs
        libgeometry-msgs-dev libvisualization-msgs-dev libros-rosgraph-msgs-dev librviz-dev pluginlib-dev
-       tf2-tools rviz catkin-lint)
+       libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure tf2-tools rviz catkin-lint)
 fi
 
 missing=()

@@ -234,6 +234,21 @@ TEST(SimulatorOptions, EveryBadParameterIsNamedWithValueAndRange) {
   EXPECT_EQ(overrides[1].second, "3");
 }
 
+TEST(SimulatorOptions, LiveSettingsStartFromTheParametersDefaults) {
+  // The node reads its parameters (written back with their defaults) before dynamic_reconfigure does;
+  // the generator's defaults are the parameters' all the same, for a reader of cfg/Simulator.cfg.
+  const SimulatorConfig config = SimulatorConfig::__getDefault__();
+  const SimulatorOptions options;
+  for (const auto& [in_config, in_options] : kLiveSettings) EXPECT_EQ(config.*in_config, options.*in_options);
+  // Every live setting is one of the options validateOptions checks: a change it refuses is refused live.
+  for (const auto& [in_config, in_options] : kLiveSettings) {
+    SimulatorOptions bad = options;
+    bad.scene_path = "scene.yaml";
+    bad.*in_options = -1.0;
+    EXPECT_EQ(validateOptions(bad).size(), 1u);
+  }
+}
+
 TEST(ControllerOptions, EveryBadParameterIsNamedWithValueAndRange) {
   ControllerOptions options;
   options.protocol_path = "protocol.yaml";

@@ -9,6 +9,7 @@ import os
 import re
 import shutil
 import signal
+import statistics
 import subprocess
 import tempfile
 import threading
@@ -161,6 +162,28 @@ while time.time() - start < 4.0:
     latencies.append(time.time() - asked)
     time.sleep(0.2)
 print(json.dumps({"start": start, "arrivals": list(arrivals), "latencies": latencies}))
+"""
+
+# Asks the simulator, through dynamic_reconfigure, for a bad gauge rate, then for twice the pace and half
+# the load-cell rate; then for 2 s of wall time, a second after the change, when each load-cell message
+# arrives and its stamp, printed as JSON with the configurations the simulator answered.
+RECONFIGURE = """
+import json
+import time
+import rospy
+from dynamic_reconfigure.client import Client
+from geometry_msgs.msg import WrenchStamped
+rospy.init_node("reconfigure", anonymous=True)
+arrivals = []
+rospy.Subscriber("/rig/load_cells", WrenchStamped, lambda m: arrivals.append(m.header.stamp.to_sec()),
+                 queue_size=100000)
+client = Client("/rig/simulator", timeout=60)
+refused = client.update_configuration({"gauge_rate": 0.0})
+changed = client.update_configuration({"real_time_factor": 0.02, "load_cell_rate": 5000.0})
+time.sleep(1.0)
+del arrivals[:]
+time.sleep(2.0)
+print(json.dumps({"refused": refused, "changed": changed, "stamps": list(arrivals)}))
 """
 
 USERS_LAUNCH = """<launch>
@@ -364,6 +387,26 @@ class RigLaunchStatusTest(unittest.TestCase):
         for count in counts:
             self.assertTrue(40 <= count <= 60, counts)
         self.assertLess(max(seen["latencies"]), 0.2, seen["latencies"])
+
+    def test_the_pace_and_the_rates_change_live_and_a_bad_change_is_refused(self):
+        with SlowRun() as run:
+            self.assertIsNotNone(run.simulator, "the simulator did not start")
+            master = master_uri(run.lines[0])
+            measured = subprocess.run(client(run.lines, ["/usr/bin/python3", "-c", RECONFIGURE]), capture_output=True,
+                                      text=True, timeout=120, env=dict(os.environ, ROS_MASTER_URI=master))
+            run.process.send_signal(signal.SIGTERM)
+            _, output = run.finish()
+        self.assertEqual(measured.returncode, 0, measured.stderr)
+        seen = json.loads(measured.stdout.strip().splitlines()[-1])
+        # A gauge rate of 0 is refused as the parameter would be, and the settings stay.
+        self.assertEqual(seen["refused"]["gauge_rate"], 1e4)
+        self.assertIn("reconfigure refused, settings kept: ~gauge_rate: value 0", output)
+        self.assertEqual((seen["changed"]["real_time_factor"], seen["changed"]["load_cell_rate"]), (0.02, 5000.0))
+        # 5 kHz of simulated time at a fiftieth of real time: 100 messages per second of wall time, within
+        # 20 %, each 0.2 ms of simulated time after the last (events add a sample off the grid).
+        self.assertTrue(160 <= len(seen["stamps"]) <= 240, len(seen["stamps"]))
+        self.assertAlmostEqual(statistics.median(b - a for a, b in zip(seen["stamps"], seen["stamps"][1:])), 2e-4,
+                               delta=1e-9)
 
     def test_a_simulator_told_to_wait_for_subscribers_that_never_come_fails_naming_them(self):
         self.assert_launch_fails(["scene:=" + SINGLE_BLOCK, "controller:=false", "wait_for_subscribers:=load_cells",

@@ -233,19 +233,20 @@ void RigSimulator::startSimulation() {
 
 void RigSimulator::addStreams(RunDriver& driver) {
   const SimulatorOptions& o = options_;
-  driver.add(std::make_unique<SampledStream<Instant>>(
+  clock_stream_ = &driver.add(std::make_unique<SampledStream<Instant>>(
       o.clock_rate, Sampling::AtSteps, [](const Simulation& s) { return Instant{s.time()}; },
       [this](const Instant& instant) { publishClock(instant.time); }));
-  driver.add(std::make_unique<SampledStream<LoadCellReading>>(
+  load_cells_stream_ = &driver.add(std::make_unique<SampledStream<LoadCellReading>>(
       o.load_cell_rate, Sampling::AtSteps, [](const Simulation& s) { return s.loadCells(); },
       [this](const LoadCellReading& cells) { emit(load_cells_pub_, "load_cells", toMsg(cells, options_.frame_id)); },
       true));
+  gauges_stream_ = nullptr;
   if (scene_.model == ModelKind::Lattice2D) {
-    driver.add(std::make_unique<SampledStream<GaugeProfile>>(
+    gauges_stream_ = &driver.add(std::make_unique<SampledStream<GaugeProfile>>(
         o.gauge_rate, Sampling::AtSteps, [](const Simulation& s) { return s.gaugeProfile(); },
         [this](const GaugeProfile& gauges) { emit(gauges_pub_, "strain_gauges", toMsg(gauges, options_.frame_id)); }));
   }
-  driver.add(
+  camera_stream_ = &driver.add(
       std::make_unique<CameraStream>(o.interface_rate, o.interface_idle_rate, [this](const InterfaceFrame& shot) {
         emit(interface_pub_, "interface", toMsg(shot, frame_index_++, options_.frame_id));
       }));
@@ -253,12 +254,55 @@ void RigSimulator::addStreams(RunDriver& driver) {
     emit(events_pub_, "slip_events",
          toMsg(event, interface_positions_, scene_.geometry.length, wave_speeds_, options_.frame_id));
   }));
-  driver.add(std::make_unique<SampledStream<StageStateReading>>(
+  stage_stream_ = &driver.add(std::make_unique<SampledStream<StageStateReading>>(
       o.stage_state_rate, Sampling::AtSteps, stageState,
       [this](const StageStateReading& reading) { publishStageState(reading); }));
   lattice_stream_ = &driver.add(std::make_unique<SampledStream<LatticeSnapshot>>(
       o.lattice_rate, Sampling::AtSteps, [](const Simulation& s) { return s.snapshot(); },
       [this](const LatticeSnapshot& snapshot) { emit(lattice_pub_, "lattice", toMsg(snapshot, options_.frame_id)); }));
+}
+
+const LiveSettings kLiveSettings = {{{&SimulatorConfig::real_time_factor, &SimulatorOptions::real_time_factor},
+                                     {&SimulatorConfig::load_cell_rate, &SimulatorOptions::load_cell_rate},
+                                     {&SimulatorConfig::gauge_rate, &SimulatorOptions::gauge_rate},
+                                     {&SimulatorConfig::interface_rate, &SimulatorOptions::interface_rate},
+                                     {&SimulatorConfig::interface_idle_rate, &SimulatorOptions::interface_idle_rate},
+                                     {&SimulatorConfig::stage_state_rate, &SimulatorOptions::stage_state_rate},
+                                     {&SimulatorConfig::clock_rate, &SimulatorOptions::clock_rate},
+                                     {&SimulatorConfig::lattice_rate, &SimulatorOptions::lattice_rate},
+                                     {&SimulatorConfig::snapshot_rate, &SimulatorOptions::snapshot_rate}}};
+
+void RigSimulator::onReconfigure(SimulatorConfig& config, std::uint32_t /*level*/) {
+  SimulatorOptions live = options_;
+  for (const auto& [in_config, in_options] : kLiveSettings) live.*in_options = config.*in_config;
+  const std::vector<std::string> problems = validateOptions(live);
+  if (problems.empty()) {
+    applyLiveSettings(live);
+    return;
+  }
+  std::string reasons;
+  for (const std::string& problem : problems) reasons += (reasons.empty() ? "" : "; ") + problem;
+  ROS_WARN_STREAM("reconfigure refused, settings kept: " << reasons);
+  for (const auto& [in_config, in_options] : kLiveSettings) config.*in_config = options_.*in_options;
+}
+
+void RigSimulator::applyLiveSettings(const SimulatorOptions& live) {
+  if (live.real_time_factor != options_.real_time_factor) {
+    // The pace goes on from where the wall clock had brought it (from the simulation's time if unpaced),
+    // at the new factor.
+    pace_origin_sim_ = options_.real_time_factor > 0.0 ? pacedTime() : simulation().time();
+    pace_origin_wall_ = ros::WallTime::now();
+    driver_->setCutJumpsAtFrames(live.real_time_factor > 0.0);
+    if (live.real_time_factor <= 0.0) releasePaced(std::numeric_limits<double>::infinity());
+  }
+  options_ = live;
+  const double now = simulation().time();
+  clock_stream_->setRate(live.clock_rate, now);
+  load_cells_stream_->setRate(live.load_cell_rate, now);
+  if (gauges_stream_) gauges_stream_->setRate(live.gauge_rate, now);
+  camera_stream_->setRates(live.interface_rate, live.interface_idle_rate, now);
+  stage_stream_->setRate(live.stage_state_rate, now);
+  lattice_stream_->setRate(live.lattice_rate, now);
 }
 
 void RigSimulator::advertise() {
@@ -282,6 +326,9 @@ void RigSimulator::advertise() {
   run_end_srv_ = nh_.advertiseService("set_run_end", &RigSimulator::onSetRunEnd, this);
   scene_pub_ = nh_.advertise<std_msgs::String>("scene", 1, true);
   publishScene();
+  // Its first values are the parameters as read (written back with their defaults).
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<SimulatorConfig>>(ros::NodeHandle("~"));
+  reconfigure_->setCallback([this](SimulatorConfig& config, std::uint32_t level) { onReconfigure(config, level); });
 }
 
 void RigSimulator::publishScene() {

@@ -3,6 +3,9 @@
 // Parameters (private, ~):
 //   scene (string, required)        path of the scene YAML (the offline runner's format)
 //   overrides (string, "")          scene fields to replace, "key=value key=value" (e.g. "pusher.height=0.01")
+//   The pace and the rates (real_time_factor to snapshot_rate) can also be changed while the rig runs,
+//   with dynamic_reconfigure (~set_parameters, `rosrun dynamic_reconfigure dynparam set`); a change is
+//   checked as the parameters are, and a bad one is refused with a logged reason, the settings kept.
 //   real_time_factor (double, 0)    simulated seconds per wall second; 0 runs as fast as possible
 //   load_cell_rate (double, 1e4)    Hz of simulated time, load_cells
 //   gauge_rate (double, 1e4)        Hz of simulated time, strain_gauges
@@ -63,6 +66,8 @@
 //                                                  so that a run ends where it should however fast it runs);
 //                                                  a condition already met is refused (call stop)
 //   pause (std_srvs/SetBool), reset (std_srvs/Trigger), stop (std_srvs/Trigger)
+//   ~set_parameters (dynamic_reconfigure/Reconfigure)  the pace and the rates, live (above); with
+//                                                  ~parameter_descriptions and ~parameter_updates
 //   abort (std_srvs/Trigger)                       ends the run as stop does, and the node then exits with
 //                                                  status 4: what drives the run could not (a controller
 //                                                  whose protocol or command was refused)
@@ -78,14 +83,17 @@
 // keeps running. A HOLD's speed and target are ignored: a hold has none.
 #pragma once
 
+#include <dynamic_reconfigure/server.h>
 #include <friction_msgs/SendStageCommand.h>
 #include <friction_msgs/SetRunEnd.h>
 #include <friction_msgs/StageCommand.h>
+#include <friction_sim/SimulatorConfig.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <std_srvs/SetBool.h>
 #include <std_srvs/Trigger.h>
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -121,6 +129,12 @@ struct SimulatorOptions {
   std::string wait_for_subscribers;     ///< "topic[:count] ...": wait at t = 0 until they subscribe
   double subscriber_timeout = 30.0;     ///< s of wall time to wait for them
 };
+
+/// The settings dynamic_reconfigure changes live (cfg/Simulator.cfg), each as the config and the options
+/// name it.
+using SimulatorConfig = friction_sim::SimulatorConfig;
+using LiveSettings = std::array<std::pair<double SimulatorConfig::*, double SimulatorOptions::*>, 9>;
+extern const LiveSettings kLiveSettings;
 
 /// ~wait_for_subscribers parsed: each topic (relative name) with its count; a problem for each bad item.
 std::vector<std::pair<std::string, int>> parseAwaitedSubscribers(const std::string& text,
@@ -210,13 +224,26 @@ class RigSimulator {
   template <class Message>
   void emit(ros::Publisher& publisher, const std::string& topic, const Message& msg);
 
+  /// dynamic_reconfigure's callback: the pace and the rates, checked as the parameters are; a refused
+  /// change is logged and `config` set back to the settings kept.
+  void onReconfigure(SimulatorConfig& config, std::uint32_t level);
+  /// Takes `live`'s pace and rates (validated) into the run under way; a reset keeps them.
+  void applyLiveSettings(const SimulatorOptions& live);
+
   ros::NodeHandle nh_;
   SimulatorOptions options_;
   Scene scene_;
   double stability_limit_ = 0.0;  ///< s, of scene_, from its validation
   const Simulation& simulation() const { return driver_->simulation(); }
-  std::unique_ptr<RunDriver> driver_;                               ///< the run since the start or the last reset
-  const SampledStream<LatticeSnapshot>* lattice_stream_ = nullptr;  ///< driver_'s
+  std::unique_ptr<RunDriver> driver_;  ///< the run since the start or the last reset
+  // driver_'s streams, for their rates; gauges_stream_ is null on a chain (no gauges).
+  SampledStream<Instant>* clock_stream_ = nullptr;
+  SampledStream<LoadCellReading>* load_cells_stream_ = nullptr;
+  SampledStream<GaugeProfile>* gauges_stream_ = nullptr;
+  CameraStream* camera_stream_ = nullptr;
+  SampledStream<StageStateReading>* stage_stream_ = nullptr;
+  SampledStream<LatticeSnapshot>* lattice_stream_ = nullptr;
+  std::unique_ptr<dynamic_reconfigure::Server<SimulatorConfig>> reconfigure_;
   std::vector<double> interface_positions_;
   WaveSpeeds wave_speeds_;
   rosbag::Bag bag_;

@@ -5,6 +5,7 @@
 // steps, jumps or interpolates. No ROS here.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -72,6 +73,11 @@ class SampledStream : public RunStream {
   double nextTime() const override { return next_; }
   /// True if the last advance produced a sample.
   bool sampledLast() const { return sampled_last_; }
+  /// A new rate (Hz of simulated time) from simulated time `now` (s): the next sample within a new period.
+  void setRate(double rate, double now) {
+    period_ = 1.0 / rate;
+    next_ = std::min(next_, now + period_);
+  }
 
   void before(const Simulation& simulation, bool commands_applied) override {
     // Interpolated, the reading after the last advance serves unless a command changed the state since.
@@ -127,6 +133,12 @@ class CameraStream : public RunStream {
   using Sink = std::function<void(const InterfaceFrame&)>;
   CameraStream(double rate, double idle_rate, Sink sink);
   double nextTime() const override { return next_; }
+  /// New rates (Hz of simulated time) from simulated time `now` (s): the next frame within a new idle period.
+  void setRates(double rate, double idle_rate, double now) {
+    rate_ = rate;
+    idle_rate_ = idle_rate;
+    next_ = std::min(next_, now + 1.0 / idle_rate);
+  }
   bool cutsJumps() const override { return true; }
   void before(const Simulation& simulation, bool commands_applied) override;
   void after(const Simulation& simulation, bool jumped) override;
@@ -205,6 +217,8 @@ class RunDriver {
   void advance();
   /// True once the run's end holds.
   bool finished() const { return (options_.stop_at_scene_end || run_end_set_) && simulation_.finished(); }
+  /// Paced runs cut their jumps at frames (RunOptions::cut_jumps_at_frames), from the next advance on.
+  void setCutJumpsAtFrames(bool cut) { options_.cut_jumps_at_frames = cut; }
   /// Advances until finished().
   void run() {
     while (!finished()) advance();
