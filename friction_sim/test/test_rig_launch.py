@@ -369,18 +369,23 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertRegex(output, r"command\(s\) from /flood_\w+ on /rig/stage_command were dropped unread: the "
                                  r"queue of 1000 was full \(%d so far\)" % dropped)
 
-    def test_a_paced_run_publishes_evenly_and_answers_services_at_once(self):
-        # At a hundredth of real time the load cells' 10 kHz of simulated time is 100 Hz of wall time;
-        # the run fast-forwards in jumps of 10 ms (a second of wall time), which came out in bursts.
+    def measured_beside_a_slow_run(self, script):
+        """What `script` printed last (JSON), run in the rig's network beside the default experiment at a
+        hundredth of real time, and the rig's output."""
         with SlowRun() as run:
             self.assertIsNotNone(run.simulator, "the simulator did not start")
             master = master_uri(run.lines[0])
-            measured = subprocess.run(client(run.lines, ["/usr/bin/python3", "-c", PACING]), capture_output=True,
+            measured = subprocess.run(client(run.lines, ["/usr/bin/python3", "-c", script]), capture_output=True,
                                       text=True, timeout=120, env=dict(os.environ, ROS_MASTER_URI=master))
             run.process.send_signal(signal.SIGTERM)
-            run.finish()
+            _, output = run.finish()
         self.assertEqual(measured.returncode, 0, measured.stderr)
-        seen = json.loads(measured.stdout.strip().splitlines()[-1])
+        return json.loads(measured.stdout.strip().splitlines()[-1]), output
+
+    def test_a_paced_run_publishes_evenly_and_answers_services_at_once(self):
+        # At a hundredth of real time the load cells' 10 kHz of simulated time is 100 Hz of wall time;
+        # the run fast-forwards in jumps of 10 ms (a second of wall time), which came out in bursts.
+        seen, _ = self.measured_beside_a_slow_run(PACING)
         # Each half second holds 50 messages, within 20 %.
         counts = [sum(1 for t in seen["arrivals"] if seen["start"] + 0.5 * k <= t < seen["start"] + 0.5 * (k + 1))
                   for k in range(8)]
@@ -389,15 +394,7 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertLess(max(seen["latencies"]), 0.2, seen["latencies"])
 
     def test_the_pace_and_the_rates_change_live_and_a_bad_change_is_refused(self):
-        with SlowRun() as run:
-            self.assertIsNotNone(run.simulator, "the simulator did not start")
-            master = master_uri(run.lines[0])
-            measured = subprocess.run(client(run.lines, ["/usr/bin/python3", "-c", RECONFIGURE]), capture_output=True,
-                                      text=True, timeout=120, env=dict(os.environ, ROS_MASTER_URI=master))
-            run.process.send_signal(signal.SIGTERM)
-            _, output = run.finish()
-        self.assertEqual(measured.returncode, 0, measured.stderr)
-        seen = json.loads(measured.stdout.strip().splitlines()[-1])
+        seen, output = self.measured_beside_a_slow_run(RECONFIGURE)
         # A gauge rate of 0 is refused as the parameter would be, and the settings stay.
         self.assertEqual(seen["refused"]["gauge_rate"], 1e4)
         self.assertIn("reconfigure refused, settings kept: ~gauge_rate: value 0", output)
