@@ -17,6 +17,7 @@
 #include "friction_sim/model/chain_1d.h"
 #include "friction_sim/run/run_driver.h"
 #include "friction_sim/run/simulation.h"
+#include "friction_sim/scene/loading_protocol.h"
 #include "one_node.h"
 #include "test_helpers.h"
 
@@ -437,13 +438,10 @@ TEST(QuasiStaticCreep, CreepingSliderHasTheFullDynamicsPrecursors) {
 struct CsvTable {
   explicit CsvTable(const std::string& text) {
     std::istringstream lines(text);
-    std::string line, cell;
+    std::string line;
     std::getline(lines, line);
-    for (std::istringstream header(line); std::getline(header, cell, ',');) columns.push_back(cell);
-    while (std::getline(lines, line)) {
-      rows.emplace_back();
-      for (std::istringstream cells(line); std::getline(cells, cell, ',');) rows.back().push_back(cell);
-    }
+    columns = splitCsvLine(line);
+    while (std::getline(lines, line)) rows.push_back(splitCsvLine(line));
   }
   bool has(const std::string& column) const {
     return std::find(columns.begin(), columns.end(), column) != columns.end();

@@ -72,6 +72,10 @@ std::vector<TimedCommand> scheduleProtocol(const LoadingProtocol& protocol, doub
 /// at which the rig applies a controller's command.
 double stampSeconds(double seconds);
 
+/// The cells of one line of the rig's CSV files (no quoting: no cell holds a comma); a trailing comma
+/// ends in an empty cell.
+std::vector<std::string> splitCsvLine(const std::string& line);
+
 /// The commands of a command table, as rig_report writes a bag's applied commands (stage_commands.csv)
 /// for friction_run --commands:
 ///

@@ -227,15 +227,6 @@ bool readStampSeconds(const std::string& text, double& seconds) {
   return true;
 }
 
-std::vector<std::string> splitCsvLine(const std::string& line) {
-  std::vector<std::string> cells;
-  std::stringstream stream(line);
-  std::string cell;
-  while (std::getline(stream, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
-
 /// Reads a command table row's time (cell 0) into `command`: a finite time >= 0 s, not before the row
 /// `before` (the last row read whose time was good, or null). Reports a problem and returns false if it
 /// cannot be read.
@@ -312,6 +303,15 @@ bool readCommandRow(const std::string& line, const TimedCommand* before, const C
 }
 
 }  // namespace
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream stream(line);
+  std::string cell;
+  while (std::getline(stream, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
 
 std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const std::string& source,
                                             const CommandCheck& check) {
