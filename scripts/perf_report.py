@@ -37,11 +37,14 @@ OUT = os.path.join(ROOT, ".build/perf")
 # extra at any size, most in short rows: REMAINDER_SIZE, also 10³ nodes, is reported beside them.
 LATTICE_SIZES = ["33/31", "57/31", "113/61", "225/121", "449/241", "1001/61", "1001/1001"]
 REMAINDER_SIZE = "32/32"
+# The lattices a naive step of the same bulk (benchmarks/naive_lattice.h) is measured on, for scale.
+NAIVE_SIZES = ["57/31", "225/121", "1001/1001"]
 # The cases the report reads by name: a bench_kernels built before one of them was added is refused at
 # the start rather than at the end of the run.
 REQUIRED_CASES = (["latticeStep/geometric/" + size for size in LATTICE_SIZES + [REMAINDER_SIZE]] +
                   ["latticeStep/linearised/57/31", "latticeStepOneAtATime/57/31", "chainStep/2", "chainStep/57",
-                   "stateStream/1767", "leapfrogStream/1767", "bondDividerFloor"])
+                   "stateStream/1767", "leapfrogStream/1767", "bondDividerFloor"] +
+                  ["naiveLatticeStep/" + size for size in NAIVE_SIZES])
 
 
 def size_label(size):
@@ -588,6 +591,15 @@ def kernels_discussion(median):
             ", and does not hold with %s" % size_label(REMAINDER_SIZE) if abs(remainder / sizes_median - 1) > 0.2
             else " (it holds with %s too on this host)" % size_label(REMAINDER_SIZE)),
     ]
+    across_sizes.append(
+        "For scale, a naive step of the same bulk (`naiveLatticeStep`, benchmarks/naive_lattice.h: each node "
+        "sums its eight bonds, so every bond is computed twice; an array of node records; velocity Verlet's "
+        "three passes each over the whole state; no contact rules, loads or pusher; its forces equal the "
+        "model's to round-off, test `LatticeNaiveReference`) costs %s ns per node-step: the model's step, which "
+        "does the contact rules and loads too, is %s as fast." % (
+            ", ".join("%.2f at %s" % (median["naiveLatticeStep/" + size], size_label(size)) for size in NAIVE_SIZES),
+            ", ".join("%.1f×" % (median["naiveLatticeStep/" + size] / median["latticeStep/geometric/" + size])
+                      for size in NAIVE_SIZES)))
     divider_paragraph = (
         "Each geometric bond takes a square root and a division, neither instruction fully pipelined: the "
         "57 × 31 lattice's square roots and divisions alone, in a loop that does nothing else "

@@ -16,9 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "friction_sim/model/lattice_2d.h"
 #include "friction_sim/run/simulation.h"
 #include "friction_sim/scene/scene_io.h"
 #include "friction_sim/solvers/integrator.h"
+#include "naive_lattice.h"
 
 namespace friction {
 namespace {
@@ -102,6 +104,21 @@ void latticeStepOneAtATime(benchmark::State& state) {
       nsPerNodeStep(static_cast<double>(state.range(0) * state.range(1)) * static_cast<double>(state.iterations()));
 }
 BENCHMARK(latticeStepOneAtATime)->Args({1001, 1001})->Args({57, 31})->Unit(benchmark::kMicrosecond);
+
+/// A naive step of the same lattice's bulk (naive_lattice.h), for scale: its springs and damping with the
+/// model's constants, the bonds turned by a displacement field as in a loaded slider.
+void naiveLatticeStep(benchmark::State& state) {
+  const Lattice2D lattice(latticeScene(static_cast<int>(state.range(0)), static_cast<int>(state.range(1))));
+  NaiveLattice naive(lattice.nodesX(), lattice.nodesZ(), lattice.spacing(), lattice.springStiffness(),
+                     lattice.dampingRate(), lattice.nodeMass());
+  for (int j = 0; j < naive.nodesZ(); ++j) {
+    for (int i = 0; i < naive.nodesX(); ++i) naive.node(i, j).ux = 1e-6 * j;
+  }
+  for (auto _ : state) naive.step(1e-8);
+  state.counters["ns_per_node_step"] =
+      nsPerNodeStep(static_cast<double>(state.range(0) * state.range(1)) * static_cast<double>(state.iterations()));
+}
+BENCHMARK(naiveLatticeStep)->Args({57, 31})->Args({225, 121})->Args({1001, 1001})->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(latticeStep, linearised, SpringForm::Linearised)
     ->Args({57, 31})
     ->Args({449, 241})

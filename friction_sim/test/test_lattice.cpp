@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 
+#include "../benchmarks/naive_lattice.h"
 #include "friction_sim/instruments/slip_events.h"
 #include "friction_sim/model/lattice_2d.h"
 #include "friction_sim/run/simulation.h"
@@ -118,6 +119,40 @@ TEST(LatticeElasticity, SimpleShearGivesShearModulusThreeEighthsOfE) {
                        (uz(ic + span, jc) - uz(ic - span, jc)) / (2 * span * l);
   const double shear_modulus = lattice.cellStress(u, ic, jc)[2] / gamma;
   EXPECT_NEAR(shear_modulus, 3.0 / 8.0 * scene.material.youngs_modulus, 0.01 * shear_modulus);
+}
+
+TEST(LatticeNaiveReference, ComputesTheModelsBulkForces) {
+  // bench_kernels measures the model's step against this naive one: it must do the same work. Away from
+  // the edges (no foundation, load or pusher there), the forces of both agree to round-off for a state
+  // that stretches and turns the bonds (the geometric springs) and moves the nodes (the damping).
+  Scene scene = freeLatticeScene(13, 9, 0.05);
+  Lattice2D lattice(scene);
+  NaiveLattice naive(lattice.nodesX(), lattice.nodesZ(), lattice.spacing(), lattice.springStiffness(),
+                     lattice.dampingRate(), lattice.nodeMass());
+  Vector u(lattice.dofCount()), v(lattice.dofCount()), force;
+  for (int j = 0; j < lattice.nodesZ(); ++j) {
+    for (int i = 0; i < lattice.nodesX(); ++i) {
+      const int node = lattice.nodeIndex(i, j);
+      NaiveLattice::Node& n = naive.node(i, j);
+      n.ux = u[lattice.xDof(node)] = 2e-5 * std::sin(0.7 * i + 1.3 * j);
+      n.uz = u[lattice.zDof(node)] = 2e-5 * std::cos(1.1 * i - 0.4 * j);
+      n.vx = v[lattice.xDof(node)] = 0.3 * std::sin(0.5 * i * j);
+      n.vz = v[lattice.zDof(node)] = 0.3 * std::cos(0.9 * i + j);
+    }
+  }
+  ForceEvaluation out;
+  lattice.evaluateInto(u, v, 0.0, force, out);
+  const double scale = force.cwiseAbs().maxCoeff();
+  ASSERT_GT(scale, 100.0);  // N: bonds of 1.35e7 N/m stretched by some 10 µm, far beyond round-off
+  ASSERT_GT(lattice.dampingRate(), 0.0);
+  for (int j = 1; j + 1 < lattice.nodesZ(); ++j) {
+    for (int i = 1; i + 1 < lattice.nodesX(); ++i) {
+      const int node = lattice.nodeIndex(i, j);
+      const std::array<double, 2> reference = naive.bondForce(i, j);
+      EXPECT_NEAR(force[lattice.xDof(node)], reference[0], 1e-12 * scale) << i << ", " << j;
+      EXPECT_NEAR(force[lattice.zDof(node)], reference[1], 1e-12 * scale) << i << ", " << j;
+    }
+  }
 }
 
 TEST(LatticeWaves, PAndSWaveSpeedsFromArrivalTimes) {
