@@ -7,22 +7,24 @@ import os
 import shutil
 import subprocess
 import tempfile
+import threading
 import unittest
 
 import numpy as np
 import rosbag
 import rospy
 import rosunit
+from catkin.find_in_workspaces import find_in_workspaces
 from friction_msgs.msg import InterfaceState, SlipEvent, StrainGaugeProfile
 from friction_sim import results
 from geometry_msgs.msg import WrenchStamped
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-FRICTION_RUN = os.path.join(ROOT, ".build", "devel", "lib", "friction_sim", "friction_run")
 
 
 def friction_run(scene, out, *assignments):
-    command = [FRICTION_RUN, os.path.join(ROOT, "friction_sim", scene), "--out", out]
+    runner = find_in_workspaces(["libexec"], project="friction_sim", path="friction_run", first_match_only=True)[0]
+    command = [runner, os.path.join(ROOT, "friction_sim", scene), "--out", out]
     if assignments:
         command += ["--set"] + list(assignments)
     subprocess.run(command, check=True, capture_output=True, timeout=300)
@@ -97,6 +99,11 @@ class ResultsTest(unittest.TestCase):
         np.testing.assert_allclose(np.diff(run.loading["time_s"][:100]), 1e-4, rtol=1e-9)
         self.assertAlmostEqual(run.loading["shear_force_N"].max(), 0.4 * 1920.0, delta=1e-6)
         self.assertEqual(run.event_nodes["event"].tolist(), [0, 1, 2])
+        # Counts are ints, every other number a float, whatever digits the file wrote (1920 for F_Z).
+        self.assertEqual(run.events["onset_normal_force_N"].dtype, np.float64)
+        self.assertEqual(run.loading["normal_force_N"].dtype, np.float64)
+        self.assertEqual(run.events["front_fits_left_out"].dtype, np.int64)
+        self.assertEqual(run.stresses["phase"].tolist()[:2], ["onset", "end"])
         self.assertIn("single_block", run.scene)
         self.assertIsNone(run.slip_map)
 
@@ -153,6 +160,20 @@ class ResultsTest(unittest.TestCase):
         order.frame(frame_at(2.0))
         order.event(event_ending(1, 1.9))
         self.assertEqual(handed, [0, 1])
+
+    def test_frames_and_events_fed_from_two_threads_hand_each_event_on_once(self):
+        # As rospy feeds them: one thread per topic.
+        order, handed = handed_in_order()
+        events = [event_ending(k, 1e-3 * k) for k in range(2000)]
+        frames = [frame_at(1e-3 * k) for k in range(2000)]
+        threads = [threading.Thread(target=lambda: [order.event(e) for e in events]),
+                   threading.Thread(target=lambda: [order.frame(f) for f in frames])]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        order.flush()
+        self.assertEqual(sorted(handed), list(range(2000)))
 
     def test_events_held_at_a_reset_or_the_runs_end_are_handed_on(self):
         order, handed = handed_in_order()

@@ -203,7 +203,8 @@ class RigReportTest(unittest.TestCase):
         write_bag(self.bag, namespace="/bench", also="/rig")
         done = self.report()
         self.assertNotEqual(done.returncode, 0)
-        self.assertIn("holds several rigs; choose one with --ns: /bench/ | /rig/", done.stderr)
+        self.assertIn("holds several rigs; choose one (rig_report --ns, results.load's namespace): /bench/ | /rig/",
+                      done.stderr)
         done = self.report("--ns", "rig")
         self.assertEqual(done.returncode, 0, done.stderr)
 

@@ -16,6 +16,7 @@ import collections
 import csv
 import math
 import os
+import threading
 
 import numpy as np
 
@@ -74,14 +75,19 @@ Run.__doc__ = """A run's results; what its source does not hold is None (a folde
 event_nodes or stresses tables). scene: the scene YAML as run ("" if not recorded)."""
 
 
-def _column(texts):
-    """Text cells as ints where all are, else floats where all are ("nan" included), else str."""
-    for kind in (int, float):
-        try:
-            return np.array([kind(text) for text in texts])
-        except ValueError:
-            continue
-    return np.array(texts, dtype=str)
+# The columns of the rig's tables that count things; every other number is a float, whatever its digits
+# (friction_run writes 1920 for 1920.0).
+INTEGER_COLUMNS = {"index", "event", "node", "global", "unfinished", "front_fits_left_out", "sliding_nodes"}
+
+
+def _column(name, texts):
+    """A column's text cells: ints for INTEGER_COLUMNS, floats ("nan" included) for the rest, str where
+    a cell is not a number (phase, command)."""
+    kind = int if name in INTEGER_COLUMNS else float
+    try:
+        return np.array([kind(t) for t in texts], dtype=kind)
+    except ValueError:
+        return np.array(texts, dtype=str)
 
 
 def read_csv(path):
@@ -91,7 +97,8 @@ def read_csv(path):
     if not rows:
         raise ValueError("%s is empty: a results table has a header row" % path)
     header, body = rows[0], rows[1:]
-    return Table(collections.OrderedDict((name, _column([row[i] for row in body])) for i, name in enumerate(header)))
+    return Table(collections.OrderedDict((name, _column(name, [row[i] for row in body]))
+                                         for i, name in enumerate(header)))
 
 
 def load_folder(folder):
@@ -165,7 +172,8 @@ def rig_namespace(path, recorded):
         raise BagError("%s holds no rig's load cells (geometry_msgs/WrenchStamped on NS/load_cells); its topics: %s"
                        % (path, " ".join(sorted(recorded))))
     if len(namespaces) > 1:
-        raise BagError("%s holds several rigs; choose one with --ns: %s" % (path, " | ".join(namespaces)))
+        raise BagError("%s holds several rigs; choose one (rig_report --ns, results.load's namespace): %s"
+                       % (path, " | ".join(namespaces)))
     return namespaces[0]
 
 
@@ -258,7 +266,7 @@ def event_row(e):
         ("global", int(e.global_event)), ("median_front_speed_m_s", median),
         ("front_speed_over_c_s", per(median, e.shear_wave_speed)),
         ("front_speed_over_c_r", per(median, e.rayleigh_speed)),
-        ("front_fits_left_out", getattr(e, "front_fits_left_out", "")),
+        ("front_fits_left_out", getattr(e, "front_fits_left_out", missing)),
         ("mean_shear_force_N", getattr(e, "mean_shear_force", missing)), ("mean_normal_force_N", mean_normal),
         ("mean_shear_ratio", per(getattr(e, "mean_shear_force", missing), mean_normal)),
         ("peak_shear_force_N", getattr(e, "peak_shear_force", missing)),
@@ -282,33 +290,46 @@ class EventsAfterFrames:
         rospy.Subscriber("slip_events", SlipEvent, order.event, queue_size=1000)
 
     At the end of a run (no frame follows an unfinished event), `flush()` hands on what is held. A stamp
-    that goes back (a reset, a looped bag) hands on what is held and starts over."""
+    that goes back (a reset, a looped bag) hands on what is held and starts over. Safe to feed from two
+    threads; `on_event` runs on the thread that fed the frame or the event that released it, outside the
+    lock, in the order the events arrived."""
 
     def __init__(self, on_event):
         self._on_event = on_event
         self._held = []
         self._latest_frame = None
+        # rospy calls each topic's callbacks on a thread of its own: frames and events come in together.
+        self._lock = threading.Lock()
 
     def frame(self, frame):
-        stamp = frame.header.stamp
-        if self._latest_frame is not None and stamp < self._latest_frame:
-            self.flush()
-        self._latest_frame = stamp
-        self._release()
+        with self._lock:
+            stamp = frame.header.stamp
+            ready = []
+            if self._latest_frame is not None and stamp < self._latest_frame:
+                ready, self._held = self._held, []
+            self._latest_frame = stamp
+            ready += self._take_ready()
+        self._hand_on(ready)
 
     def event(self, event):
-        self._held.append(event)
-        self._release()
+        with self._lock:
+            self._held.append(event)
+            ready = self._take_ready()
+        self._hand_on(ready)
 
     def flush(self):
-        held, self._held = self._held, []
-        for event in held:
-            self._on_event(event)
+        with self._lock:
+            ready, self._held = self._held, []
+        self._hand_on(ready)
 
-    def _release(self):
+    def _take_ready(self):
+        """Removes and returns the held events whose closing frame has come (call with the lock held)."""
         if self._latest_frame is None:
-            return
+            return []
         ready = [e for e in self._held if e.header.stamp <= self._latest_frame]
         self._held = [e for e in self._held if e.header.stamp > self._latest_frame]
-        for event in ready:
+        return ready
+
+    def _hand_on(self, events):
+        for event in events:
             self._on_event(event)
