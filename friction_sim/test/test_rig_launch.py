@@ -165,8 +165,9 @@ print(json.dumps({"start": start, "arrivals": list(arrivals), "latencies": laten
 """
 
 # Asks the simulator, through dynamic_reconfigure, for a bad gauge rate, then for twice the pace and half
-# the load-cell rate; then for 2 s of wall time, a second after the change, when each load-cell message
-# arrives and its stamp, printed as JSON with the configurations the simulator answered.
+# the load-cell rate, and notes the load cells' stamps for 2 s of wall time a second after the change;
+# then for a negative pace, then for no pace, and notes the simulated time the load cells reach 3 s
+# later. Printed as JSON with the configurations the simulator answered.
 RECONFIGURE = """
 import json
 import time
@@ -183,7 +184,13 @@ changed = client.update_configuration({"real_time_factor": 0.02, "load_cell_rate
 time.sleep(1.0)
 del arrivals[:]
 time.sleep(2.0)
-print(json.dumps({"refused": refused, "changed": changed, "stamps": list(arrivals)}))
+stamps = list(arrivals)
+negative = client.update_configuration({"real_time_factor": -1.0})
+client.update_configuration({"real_time_factor": 0.0})
+unpaced_from = arrivals[-1]
+time.sleep(3.0)
+print(json.dumps({"refused": refused, "changed": changed, "stamps": stamps, "negative": negative,
+                  "unpaced_from": unpaced_from, "unpaced_to": arrivals[-1]}))
 """
 
 USERS_LAUNCH = """<launch>
@@ -405,6 +412,12 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertTrue(160 <= len(seen["stamps"]) <= 240, len(seen["stamps"]))
         self.assertAlmostEqual(statistics.median(b - a for a, b in zip(seen["stamps"], seen["stamps"][1:])), 2e-4,
                                delta=1e-8)
+        # A negative pace is refused naming the value given (not clamped to 0 on the way), and the pace kept.
+        self.assertEqual(seen["negative"]["real_time_factor"], 0.02)
+        self.assertIn("reconfigure refused, settings kept: ~real_time_factor: value -1", output)
+        # No pace: the run goes on as fast as it can, far beyond the 0.06 s of simulated time that 3 s of
+        # wall time at 0.02 would give (the default experiment ends at 0.84 s).
+        self.assertGreater(seen["unpaced_to"] - seen["unpaced_from"], 0.3)
 
     def test_a_simulator_told_to_wait_for_subscribers_that_never_come_fails_naming_them(self):
         self.assert_launch_fails(["scene:=" + SINGLE_BLOCK, "controller:=false", "wait_for_subscribers:=load_cells",

@@ -295,6 +295,7 @@ void RigSimulator::applyLiveSettings(const SimulatorOptions& live) {
     driver_->setCutJumpsAtFrames(live.real_time_factor > 0.0);
     if (live.real_time_factor <= 0.0) releasePaced(std::numeric_limits<double>::infinity());
   }
+  next_snapshot_ = std::min(next_snapshot_, ros::WallTime::now() + ros::WallDuration(1.0 / live.snapshot_rate));
   options_ = live;
   const double now = simulation().time();
   clock_stream_->setRate(live.clock_rate, now);
@@ -537,11 +538,12 @@ void RigSimulator::releasePaced(double until) {
 }
 
 void RigSimulator::pace() {
-  if (options_.real_time_factor <= 0.0) return;
   // A step or a jump computes ahead of the wall clock: its messages go out as their simulated times come
   // due, not in a burst, and services and commands are answered meanwhile.
   constexpr double kSlice = 0.01;  // s of wall time between releases and spins
   while (!paused_ && !stop_ && !reset_requested_ && !g_stop_requested && ros::ok()) {
+    // Unpaced from the start, or since a live change answered below.
+    if (options_.real_time_factor <= 0.0) return;
     releasePaced(pacedTime());
     const double ahead = (simulation().time() - pacedTime()) / options_.real_time_factor;
     if (ahead <= 1e-3) return;

@@ -133,11 +133,12 @@ class CameraStream : public RunStream {
   using Sink = std::function<void(const InterfaceFrame&)>;
   CameraStream(double rate, double idle_rate, Sink sink);
   double nextTime() const override { return next_; }
-  /// New rates (Hz of simulated time) from simulated time `now` (s): the next frame within a new idle period.
+  /// New rates (Hz of simulated time) from simulated time `now` (s): the next frame within a new period of
+  /// the faster of the two (one frame early at most, where all sticks).
   void setRates(double rate, double idle_rate, double now) {
     rate_ = rate;
     idle_rate_ = idle_rate;
-    next_ = std::min(next_, now + 1.0 / idle_rate);
+    next_ = std::min(next_, now + 1.0 / std::max(rate, idle_rate));
   }
   bool cutsJumps() const override { return true; }
   void before(const Simulation& simulation, bool commands_applied) override;
