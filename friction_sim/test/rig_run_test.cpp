@@ -88,7 +88,8 @@ int runCommand(const std::string& command, std::string& output) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-/// A shell command run in the background for the object's lifetime; interrupted (SIGINT) at its end.
+/// A shell command run in the background for the object's lifetime; interrupted (SIGINT) at its end, and
+/// killed if it has not ended 5 s later (rosbag play still waiting for subscribers ignores SIGINT).
 class BackgroundCommand {
  public:
   explicit BackgroundCommand(const std::string& command) {
@@ -98,12 +99,18 @@ class BackgroundCommand {
       execl("/bin/sh", "sh", "-c", exec_command.c_str(), static_cast<char*>(nullptr));
       _exit(127);
     }
+    EXPECT_GT(pid_, 0) << "cannot start " << command;
   }
   BackgroundCommand(const BackgroundCommand&) = delete;
   BackgroundCommand& operator=(const BackgroundCommand&) = delete;
   ~BackgroundCommand() {
     if (pid_ <= 0) return;
     kill(pid_, SIGINT);
+    for (int waited = 0; waited < 50; ++waited) {
+      if (waitpid(pid_, nullptr, WNOHANG) == pid_) return;
+      ros::WallDuration(0.1).sleep();
+    }
+    kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
   }
 
