@@ -239,12 +239,12 @@ TEST(SimulatorOptions, LiveSettingsStartFromTheParametersDefaults) {
   // the generator's defaults are the parameters' all the same, for a reader of cfg/Simulator.cfg.
   const SimulatorConfig config = SimulatorConfig::__getDefault__();
   const SimulatorOptions options;
-  for (const auto& [in_config, in_options] : kLiveSettings) EXPECT_EQ(config.*in_config, options.*in_options);
+  for (const LiveSetting& setting : kLiveSettings) EXPECT_EQ(config.*setting.in_config, options.*setting.in_options);
   // Every live setting is one of the options validateOptions checks: a change it refuses is refused live.
-  for (const auto& [in_config, in_options] : kLiveSettings) {
+  for (const LiveSetting& setting : kLiveSettings) {
     SimulatorOptions bad = options;
     bad.scene_path = "scene.yaml";
-    bad.*in_options = -1.0;
+    bad.*setting.in_options = -1.0;
     EXPECT_EQ(validateOptions(bad).size(), 1u);
   }
 }

@@ -139,7 +139,7 @@ def load(path, namespace=None, event_source="simulator"):
     return Run(events=event_table(recording.events),
                loading=Table(collections.OrderedDict([("time_s", loading[:, 0]), ("shear_force_N", loading[:, 1]),
                                                       ("normal_force_N", loading[:, 2])])),
-               slip_map=SlipMap(np.array([f[0] for f in frames]), np.array(frames[0][1]) if frames else np.array([]),
+               slip_map=SlipMap(np.array([f[0] for f in frames]), np.array(frames[0][1]),
                                 np.array([f[2] for f in frames])) if frames else None,
                gauges=recording.gauges, event_nodes=None, stresses=None, scene=recording.scene)
 

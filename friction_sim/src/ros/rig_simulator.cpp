@@ -99,20 +99,31 @@ std::vector<std::pair<std::string, int>> parseAwaitedSubscribers(const std::stri
   return awaited;
 }
 
+const LiveSettings kLiveSettings = {
+    {{"real_time_factor", &SimulatorConfig::real_time_factor, &SimulatorOptions::real_time_factor},
+     {"load_cell_rate", &SimulatorConfig::load_cell_rate, &SimulatorOptions::load_cell_rate},
+     {"gauge_rate", &SimulatorConfig::gauge_rate, &SimulatorOptions::gauge_rate},
+     {"interface_rate", &SimulatorConfig::interface_rate, &SimulatorOptions::interface_rate},
+     {"interface_idle_rate", &SimulatorConfig::interface_idle_rate, &SimulatorOptions::interface_idle_rate},
+     {"stage_state_rate", &SimulatorConfig::stage_state_rate, &SimulatorOptions::stage_state_rate},
+     {"clock_rate", &SimulatorConfig::clock_rate, &SimulatorOptions::clock_rate},
+     {"lattice_rate", &SimulatorConfig::lattice_rate, &SimulatorOptions::lattice_rate},
+     {"snapshot_rate", &SimulatorConfig::snapshot_rate, &SimulatorOptions::snapshot_rate}}};
+
 std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   std::vector<std::string> problems;
   auto require = [&](bool ok, const std::string& name, double value, const std::string& allowed) {
     requireSetting(ok, "~" + name, value, allowed, problems);
   };
   if (o.scene_path.empty()) problems.push_back("~scene: no value; allowed: the path of a scene YAML file");
-  require(std::isfinite(o.real_time_factor) && o.real_time_factor >= 0.0, "real_time_factor", o.real_time_factor,
-          ">= 0 (0 = as fast as possible)");
-  const std::pair<const char*, double> rates[] = {
-      {"load_cell_rate", o.load_cell_rate},     {"gauge_rate", o.gauge_rate},
-      {"interface_rate", o.interface_rate},     {"interface_idle_rate", o.interface_idle_rate},
-      {"stage_state_rate", o.stage_state_rate}, {"clock_rate", o.clock_rate},
-      {"lattice_rate", o.lattice_rate},         {"snapshot_rate", o.snapshot_rate}};
-  for (const auto& [name, rate] : rates) require(std::isfinite(rate) && rate > 0.0, name, rate, "a rate > 0 Hz");
+  for (const LiveSetting& setting : kLiveSettings) {
+    const double value = o.*setting.in_options;
+    if (setting.in_options == &SimulatorOptions::real_time_factor) {
+      require(std::isfinite(value) && value >= 0.0, setting.name, value, ">= 0 (0 = as fast as possible)");
+    } else {
+      require(std::isfinite(value) && value > 0.0, setting.name, value, "a rate > 0 Hz");
+    }
+  }
   if (o.frame_id.empty()) problems.push_back("~frame_id: empty; allowed: a frame name such as 'slider'");
   if (!bagCompression(o.bag_compression)) {
     problems.push_back("~bag_compression: value '" + o.bag_compression + "' is not allowed; allowed: lz4, bz2, none");
@@ -128,15 +139,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   SimulatorOptions o;
   readParameter(pnh, "scene", o.scene_path);
   readParameter(pnh, "overrides", o.overrides);
-  readParameter(pnh, "real_time_factor", o.real_time_factor);
-  readParameter(pnh, "load_cell_rate", o.load_cell_rate);
-  readParameter(pnh, "gauge_rate", o.gauge_rate);
-  readParameter(pnh, "interface_rate", o.interface_rate);
-  readParameter(pnh, "interface_idle_rate", o.interface_idle_rate);
-  readParameter(pnh, "stage_state_rate", o.stage_state_rate);
-  readParameter(pnh, "clock_rate", o.clock_rate);
-  readParameter(pnh, "lattice_rate", o.lattice_rate);
-  readParameter(pnh, "snapshot_rate", o.snapshot_rate);
+  for (const LiveSetting& setting : kLiveSettings) readParameter(pnh, setting.name, o.*setting.in_options);
   readParameter(pnh, "bag", o.bag_path);
   readParameter(pnh, "bag_compression", o.bag_compression);
   readParameter(pnh, "frame_id", o.frame_id);
@@ -262,19 +265,9 @@ void RigSimulator::addStreams(RunDriver& driver) {
       [this](const LatticeSnapshot& snapshot) { emit(lattice_pub_, "lattice", toMsg(snapshot, options_.frame_id)); }));
 }
 
-const LiveSettings kLiveSettings = {{{&SimulatorConfig::real_time_factor, &SimulatorOptions::real_time_factor},
-                                     {&SimulatorConfig::load_cell_rate, &SimulatorOptions::load_cell_rate},
-                                     {&SimulatorConfig::gauge_rate, &SimulatorOptions::gauge_rate},
-                                     {&SimulatorConfig::interface_rate, &SimulatorOptions::interface_rate},
-                                     {&SimulatorConfig::interface_idle_rate, &SimulatorOptions::interface_idle_rate},
-                                     {&SimulatorConfig::stage_state_rate, &SimulatorOptions::stage_state_rate},
-                                     {&SimulatorConfig::clock_rate, &SimulatorOptions::clock_rate},
-                                     {&SimulatorConfig::lattice_rate, &SimulatorOptions::lattice_rate},
-                                     {&SimulatorConfig::snapshot_rate, &SimulatorOptions::snapshot_rate}}};
-
 void RigSimulator::onReconfigure(SimulatorConfig& config, std::uint32_t /*level*/) {
   SimulatorOptions live = options_;
-  for (const auto& [in_config, in_options] : kLiveSettings) live.*in_options = config.*in_config;
+  for (const LiveSetting& setting : kLiveSettings) live.*setting.in_options = config.*setting.in_config;
   const std::vector<std::string> problems = validateOptions(live);
   if (problems.empty()) {
     applyLiveSettings(live);
@@ -283,7 +276,7 @@ void RigSimulator::onReconfigure(SimulatorConfig& config, std::uint32_t /*level*
   std::string reasons;
   for (const std::string& problem : problems) reasons += (reasons.empty() ? "" : "; ") + problem;
   ROS_WARN_STREAM("reconfigure refused, settings kept: " << reasons);
-  for (const auto& [in_config, in_options] : kLiveSettings) config.*in_config = options_.*in_options;
+  for (const LiveSetting& setting : kLiveSettings) config.*setting.in_config = options_.*setting.in_options;
 }
 
 void RigSimulator::applyLiveSettings(const SimulatorOptions& live) {

@@ -130,10 +130,16 @@ struct SimulatorOptions {
   double subscriber_timeout = 30.0;     ///< s of wall time to wait for them
 };
 
-/// The settings dynamic_reconfigure changes live (cfg/Simulator.cfg), each as the config and the options
-/// name it.
 using SimulatorConfig = friction_sim::SimulatorConfig;
-using LiveSettings = std::array<std::pair<double SimulatorConfig::*, double SimulatorOptions::*>, 9>;
+/// A setting dynamic_reconfigure changes live (cfg/Simulator.cfg): its parameter's name and its field in
+/// the config and in the options.
+struct LiveSetting {
+  const char* name;
+  double SimulatorConfig::*in_config;
+  double SimulatorOptions::*in_options;
+};
+/// The pace, then the rates: read, checked and changed live through this one list.
+using LiveSettings = std::array<LiveSetting, 9>;
 extern const LiveSettings kLiveSettings;
 
 /// ~wait_for_subscribers parsed: each topic (relative name) with its count; a problem for each bad item.
