@@ -462,6 +462,9 @@ TEST(FullRun, BadCommandsAndParametersAreRefusedAndTheRigKeepsRunning) {
   EXPECT_EQ(g_seen.bad_parameter_status, 2);
   EXPECT_NE(g_seen.bad_parameter_output.find("~load_cell_rate: value -1"), std::string::npos)
       << g_seen.bad_parameter_output;
+  EXPECT_NE(g_seen.bad_parameter_output.find("~gauge_rate: value 'fast' is not allowed; allowed: a number"),
+            std::string::npos)
+      << g_seen.bad_parameter_output;
   // A refused protocol lists every problem, and the controller aborts the run of the simulator that waits
   // for it rather than leave it waiting (the simulator then exits with status 4: test_rig_launch.py).
   EXPECT_EQ(g_seen.bad_protocol_status, 2);
@@ -681,9 +684,9 @@ void watchFullRun(ros::NodeHandle& nh) {
   ros::NodeHandle pnh("~");
   std::string scene;
   pnh.getParam("scene", scene);
-  g_seen.bad_parameter_status =
-      runCommand("rosrun friction_sim rig_simulator __name:=bad_parameter _load_cell_rate:=-1.0 _scene:=" + scene,
-                 g_seen.bad_parameter_output);
+  const std::string bad_parameters = " _load_cell_rate:=-1.0 _gauge_rate:=fast _scene:=" + scene;
+  g_seen.bad_parameter_status = runCommand("rosrun friction_sim rig_simulator __name:=bad_parameter" + bad_parameters,
+                                           g_seen.bad_parameter_output);
   g_seen.bad_detector_status =
       runCommand("rosrun friction_sim precursor_detector __name:=bad_detector _front_fit_nodes:=1 _overrides:=broken",
                  g_seen.bad_detector_output);

@@ -20,10 +20,11 @@ std::vector<std::string> validateDetectorOptions(const DetectorOptions& options)
 
 DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh) {
   DetectorOptions options;
-  readParameter(private_nh, "front_fit_nodes", options.front_fit_nodes);
-  readParameter(private_nh, "scene", options.scene_path);
-  readParameter(private_nh, "overrides", options.overrides);
-  refuseParameters(private_nh, validateDetectorOptions(options));
+  ParameterReader reader(private_nh);
+  reader.read("front_fit_nodes", options.front_fit_nodes);
+  reader.read("scene", options.scene_path);
+  reader.read("overrides", options.overrides);
+  reader.refuseIfAny(validateDetectorOptions(options));
   return options;
 }
 

@@ -137,17 +137,18 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
 
 SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   SimulatorOptions o;
-  readParameter(pnh, "scene", o.scene_path);
-  readParameter(pnh, "overrides", o.overrides);
-  for (const LiveSetting& setting : kLiveSettings) readParameter(pnh, setting.name, o.*setting.in_options);
-  readParameter(pnh, "bag", o.bag_path);
-  readParameter(pnh, "bag_compression", o.bag_compression);
-  readParameter(pnh, "frame_id", o.frame_id);
-  readParameter(pnh, "stop_at_scene_end", o.stop_at_scene_end);
-  readParameter(pnh, "start_paused", o.start_paused);
-  readParameter(pnh, "wait_for_subscribers", o.wait_for_subscribers);
-  readParameter(pnh, "subscriber_timeout", o.subscriber_timeout);
-  refuseParameters(pnh, validateOptions(o));
+  ParameterReader reader(pnh);
+  reader.read("scene", o.scene_path);
+  reader.read("overrides", o.overrides);
+  for (const LiveSetting& setting : kLiveSettings) reader.read(setting.name, o.*setting.in_options);
+  reader.read("bag", o.bag_path);
+  reader.read("bag_compression", o.bag_compression);
+  reader.read("frame_id", o.frame_id);
+  reader.read("stop_at_scene_end", o.stop_at_scene_end);
+  reader.read("start_paused", o.start_paused);
+  reader.read("wait_for_subscribers", o.wait_for_subscribers);
+  reader.read("subscriber_timeout", o.subscriber_timeout);
+  reader.refuseIfAny(validateOptions(o));
   return o;
 }
 

@@ -25,9 +25,10 @@ std::vector<std::string> validateControllerOptions(const ControllerOptions& opti
 
 ControllerOptions readControllerOptions(const ros::NodeHandle& private_nh) {
   ControllerOptions options;
-  readParameter(private_nh, "protocol", options.protocol_path);
-  readParameter(private_nh, "start_delay", options.start_delay);
-  refuseParameters(private_nh, validateControllerOptions(options));
+  ParameterReader reader(private_nh);
+  reader.read("protocol", options.protocol_path);
+  reader.read("start_delay", options.start_delay);
+  reader.refuseIfAny(validateControllerOptions(options));
   return options;
 }
 
