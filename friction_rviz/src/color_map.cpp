@@ -67,27 +67,29 @@ bool signedField(Field field) {
   return field == Field::SigmaZZ || field == Field::TauXZ || field == Field::StressRatio;
 }
 
-std::vector<double> fieldValues(Field field, const std::vector<double>& sigma_xx, const std::vector<double>& sigma_zz,
-                                const std::vector<double>& tau_xz, const std::vector<double>& speed) {
+std::vector<double> fieldValues(Field field, const std::vector<float>& sigma_xx, const std::vector<float>& sigma_zz,
+                                const std::vector<float>& tau_xz, const std::vector<float>& speed) {
   const std::size_t n = field == Field::Speed ? speed.size() : sigma_zz.size();
   std::vector<double> out(n);
   for (std::size_t i = 0; i < n; ++i) {
+    // In double: the squares of stresses of megapascals lose digits in float.
+    const auto at = [i](const std::vector<float>& values) { return static_cast<double>(values[i]); };
     switch (field) {
       case Field::SigmaZZ:
-        out[i] = sigma_zz[i];
+        out[i] = at(sigma_zz);
         break;
       case Field::TauXZ:
-        out[i] = tau_xz[i];
+        out[i] = at(tau_xz);
         break;
       case Field::StressRatio:
-        out[i] = sigma_zz[i] < 0.0 ? tau_xz[i] / -sigma_zz[i] : std::numeric_limits<double>::quiet_NaN();
+        out[i] = at(sigma_zz) < 0.0 ? at(tau_xz) / -at(sigma_zz) : std::numeric_limits<double>::quiet_NaN();
         break;
       case Field::VonMises:
-        out[i] = std::sqrt(sigma_xx[i] * sigma_xx[i] - sigma_xx[i] * sigma_zz[i] + sigma_zz[i] * sigma_zz[i] +
-                           3.0 * tau_xz[i] * tau_xz[i]);
+        out[i] = std::sqrt(at(sigma_xx) * at(sigma_xx) - at(sigma_xx) * at(sigma_zz) + at(sigma_zz) * at(sigma_zz) +
+                           3.0 * at(tau_xz) * at(tau_xz));
         break;
       case Field::Speed:
-        out[i] = speed[i];
+        out[i] = at(speed);
         break;
     }
   }

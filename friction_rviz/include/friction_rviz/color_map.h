@@ -37,8 +37,8 @@ bool signedField(Field field);
 
 /// Per-node value of `field` from node stresses (Pa) and speeds (m/s): τ/σ is τ_xz/(−σ_zz) (the
 /// shear-to-compression ratio, NaN where the node is not compressed); von Mises in plane stress.
-std::vector<double> fieldValues(Field field, const std::vector<double>& sigma_xx, const std::vector<double>& sigma_zz,
-                                const std::vector<double>& tau_xz, const std::vector<double>& speed);
+std::vector<double> fieldValues(Field field, const std::vector<float>& sigma_xx, const std::vector<float>& sigma_zz,
+                                const std::vector<float>& tau_xz, const std::vector<float>& speed);
 
 /// Colour of an interface node by contact state: stuck blue, sliding red, contact lost grey.
 Rgb contactColor(unsigned state);

@@ -69,9 +69,9 @@ friction_msgs::StrainGaugeProfile toMsg(const GaugeProfile& profile, const std::
   msg.header = header(profile.time, frame_id);
   msg.height = profile.height;
   msg.position = profile.position;
-  msg.sigma_xx = profile.stress.sigma_xx;
-  msg.sigma_zz = profile.stress.sigma_zz;
-  msg.tau_xz = profile.stress.tau_xz;
+  msg.sigma_xx.assign(profile.stress.sigma_xx.begin(), profile.stress.sigma_xx.end());
+  msg.sigma_zz.assign(profile.stress.sigma_zz.begin(), profile.stress.sigma_zz.end());
+  msg.tau_xz.assign(profile.stress.tau_xz.begin(), profile.stress.tau_xz.end());
   return msg;
 }
 
@@ -152,12 +152,12 @@ friction_msgs::LatticeSnapshot toMsg(const LatticeSnapshot& snapshot, const std:
   msg.nodes_x = snapshot.nodes_x;
   msg.nodes_z = snapshot.nodes_z;
   msg.spacing = snapshot.spacing;
-  msg.x = snapshot.x;
-  msg.z = snapshot.z;
-  msg.speed = snapshot.speed;
-  msg.sigma_xx = snapshot.stress.sigma_xx;
-  msg.sigma_zz = snapshot.stress.sigma_zz;
-  msg.tau_xz = snapshot.stress.tau_xz;
+  msg.x.assign(snapshot.x.begin(), snapshot.x.end());
+  msg.z.assign(snapshot.z.begin(), snapshot.z.end());
+  msg.speed.assign(snapshot.speed.begin(), snapshot.speed.end());
+  msg.sigma_xx.assign(snapshot.stress.sigma_xx.begin(), snapshot.stress.sigma_xx.end());
+  msg.sigma_zz.assign(snapshot.stress.sigma_zz.begin(), snapshot.stress.sigma_zz.end());
+  msg.tau_xz.assign(snapshot.stress.tau_xz.begin(), snapshot.stress.tau_xz.end());
   msg.interface_state = snapshot.interface_state;
   msg.stage_position = snapshot.stage_position;
   msg.pusher_height = snapshot.pusher_height;
