@@ -401,6 +401,40 @@ TEST(FullRun, StageTravelFollowsThePositionAcrossFastForwardJumps) {
   EXPECT_GT(states.back()->travel, 0.0);
 }
 
+TEST(FullRun, GaugesAreFastDuringEventsAndSlowBetweenThem) {
+  // full_run.test gives gauge_idle_rate as roslaunch's string "2e3": read as the number and written back
+  // as one. In the bag, each profile taken during an event is followed within 10 µs (100 kHz, the
+  // default) and a step of 0.4 µs; between events, profiles come every 0.5 ms, give or take a step.
+  double idle_rate = 0.0;
+  ASSERT_TRUE(ros::param::get("/rig/simulator/gauge_idle_rate", idle_rate));
+  EXPECT_EQ(idle_rate, 2e3);
+  const auto profiles = readTopic<friction_msgs::StrainGaugeProfile>(g_bag, "/rig/strain_gauges");
+  const auto events = readTopic<friction_msgs::SlipEvent>(g_bag, "/rig/slip_events");
+  ASSERT_GE(events.size(), 2u);
+  const double dt = 4e-7, slack = 1e-9;  // stamps are whole nanoseconds
+  auto during_event = [&events](double t) {
+    return std::any_of(events.begin(), events.end(),
+                       [t](const auto& e) { return e->onset_time <= t && t < e->end_time; });
+  };
+  auto onset_between = [&events](double a, double b) {
+    return std::any_of(events.begin(), events.end(),
+                       [a, b](const auto& e) { return a < e->onset_time && e->onset_time <= b; });
+  };
+  int fast = 0, slow = 0;
+  for (std::size_t k = 0; k + 1 < profiles.size(); ++k) {
+    const double t = profiles[k]->header.stamp.toSec(), next = profiles[k + 1]->header.stamp.toSec();
+    if (during_event(t)) {
+      ++fast;
+      EXPECT_LE(next - t, 1e-5 + dt + slack) << "after t = " << t;
+    } else if (!during_event(next) && !onset_between(t, next)) {
+      ++slow;
+      EXPECT_NEAR(next - t, 5e-4, dt + slack) << "after t = " << t;
+    }
+  }
+  EXPECT_GT(fast, static_cast<int>(events.size()));
+  EXPECT_GT(slow, 10);
+}
+
 TEST(FullRun, LatticeSnapshotsShowTheLoadedSlider) {
   ASSERT_GT(g_seen.lattice_snapshots, 0);
   const auto& lattice = g_seen.last_lattice;

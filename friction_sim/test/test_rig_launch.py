@@ -403,7 +403,7 @@ class RigLaunchStatusTest(unittest.TestCase):
     def test_the_pace_and_the_rates_change_live_and_a_bad_change_is_refused(self):
         seen, output = self.measured_beside_a_slow_run(RECONFIGURE)
         # A gauge rate of 0 is refused as the parameter would be, and the settings stay.
-        self.assertEqual(seen["refused"]["gauge_rate"], 1e4)
+        self.assertEqual(seen["refused"]["gauge_rate"], 1e5)
         self.assertIn("reconfigure refused, settings kept: ~gauge_rate: value 0", output)
         self.assertEqual((seen["changed"]["real_time_factor"], seen["changed"]["load_cell_rate"]), (0.02, 5000.0))
         # 5 kHz of simulated time at a fiftieth of real time: 100 messages per second of wall time, within

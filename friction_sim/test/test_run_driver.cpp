@@ -2,6 +2,7 @@
 // sample on their own clocks and never change the run; its commands and run end act as the rig's.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -25,7 +26,7 @@ Scene blockScene(bool fast_forward, double stop_time) {
 }
 constexpr double kStageStiffness = 4.0e6, kStageSpeed = 4.0e-4, kFirstSlip = 0.4 * 1920.0 / (4.0e6 * 4.0e-4);
 
-/// Every stream the simulator node registers, each counting what it receives.
+/// Every stream the simulator node registers, at its default rates, each counting what it receives.
 struct Counts {
   int clock = 0, cells = 0, gauges = 0, frames = 0, started = 0, ended = 0, stage = 0, lattice = 0;
 };
@@ -37,15 +38,16 @@ void addEveryStream(RunDriver& driver, Counts& counts) {
       1e4, Sampling::AtSteps, [](const Simulation& s) { return s.loadCells(); },
       [&counts](const LoadCellReading&) { ++counts.cells; }, true));
   driver.add(std::make_unique<SampledStream<GaugeProfile>>(
-      1e4, Sampling::AtSteps, [](const Simulation& s) { return s.gaugeProfile(); },
+      SampleRates{1e5, 1e3}, Sampling::AtSteps, [](const Simulation& s) { return s.gaugeProfile(); },
       [&counts](const GaugeProfile&) { ++counts.gauges; }));
-  driver.add(std::make_unique<CameraStream>(1e5, 100.0, [&counts](const InterfaceFrame&) { ++counts.frames; }));
+  driver.add(
+      std::make_unique<CameraStream>(SampleRates{1e5, 100.0}, [&counts](const InterfaceFrame&) { ++counts.frames; }));
   driver.add(std::make_unique<EventStream>([&counts](const Simulation&) { ++counts.started; },
                                            [&counts](const Simulation&, const SlipEvent&) { ++counts.ended; }));
   driver.add(std::make_unique<SampledStream<StageStateReading>>(
       1e3, Sampling::AtSteps, stageState, [&counts](const StageStateReading&) { ++counts.stage; }));
   driver.add(std::make_unique<SampledStream<LatticeSnapshot>>(
-      200.0, Sampling::AtSteps, [](const Simulation& s) { return s.snapshot(); },
+      SampleRates{1e4, 50.0}, Sampling::AtSteps, [](const Simulation& s) { return s.snapshot(); },
       [&counts](const LatticeSnapshot&) { ++counts.lattice; }));
 }
 
@@ -66,8 +68,9 @@ TEST(RunDriver, StreamsNeverChangeTheRun) {
   // Each clock's samples: one per period up to the end, none at t = 0.
   EXPECT_EQ(counts.clock, static_cast<int>(std::floor(t * 1e4 + 1e-9)));
   EXPECT_EQ(counts.stage, static_cast<int>(std::floor(t * 1e3 + 1e-9)));
-  EXPECT_EQ(counts.lattice, static_cast<int>(std::floor(t * 200.0 + 1e-9)));
-  EXPECT_EQ(counts.gauges, counts.clock);
+  // Those with an event rate: at least their idle clock's samples.
+  EXPECT_GE(counts.lattice, static_cast<int>(std::floor(t * 50.0 + 1e-9)));
+  EXPECT_GE(counts.gauges, static_cast<int>(std::floor(t * 1e3 + 1e-9)));
   // The load cells also at each event's first and last step.
   const int events = static_cast<int>(watched.simulation().events().size());
   EXPECT_GE(counts.cells, counts.clock + events);
@@ -111,6 +114,59 @@ TEST(RunDriver, SamplesAtStepsComeAtTheFirstStepEndOnOrAfterTheirTime) {
   }
 }
 
+/// A reading that remembers whether a slip event ran when it was taken (false when interpolated across a
+/// jump, where all sticks).
+struct EventFlag {
+  double time = 0.0;
+  bool in_event = false;
+};
+EventFlag interpolate(const EventFlag& /*a*/, const EventFlag& /*b*/, double t) { return {t, false}; }
+
+TEST(RunDriver, StreamsWithAnEventRateSampleFastInEventsAndSlowlyBetween) {
+  // Gauges at the simulator's defaults, 1e5 Hz while an event runs and 1e3 Hz while all sticks, on a 2D
+  // slider with precursors and fast-forward between them: every event is sampled at least every 10 µs
+  // (give or take a step), and the loading between events every millisecond.
+  const Scene scene = coarseSliderScene(true);
+  RunDriver driver(scene, requireValidScene(scene));
+  std::vector<EventFlag> samples;
+  driver.add(std::make_unique<SampledStream<EventFlag>>(
+      SampleRates{1e5, 1e3}, Sampling::AtSteps,
+      [](const Simulation& s) {
+        return EventFlag{s.time(), s.inEvent()};
+      },
+      [&samples](const EventFlag& sample) { samples.push_back(sample); }));
+  driver.run();
+  const std::vector<SlipEvent>& events = driver.simulation().events();
+  ASSERT_GE(events.size(), 3U);
+  const double dt = scene.integrator.time_step;
+  auto onset_between = [&events](double a, double b) {
+    return std::any_of(events.begin(), events.end(),
+                       [a, b](const SlipEvent& e) { return e.onset_time > a && e.onset_time <= b; });
+  };
+  int in_events = 0, idle_gaps = 0;
+  for (std::size_t k = 0; k + 1 < samples.size(); ++k) {
+    const double gap = samples[k + 1].time - samples[k].time;
+    if (samples[k].in_event) {
+      ++in_events;
+      EXPECT_LE(gap, 1e-5 + dt + 1e-12) << "after t = " << samples[k].time;
+    } else if (!samples[k + 1].in_event && !onset_between(samples[k].time, samples[k + 1].time)) {
+      ++idle_gaps;
+      EXPECT_NEAR(gap, 1e-3, dt + 1e-12) << "after t = " << samples[k].time;
+    }
+  }
+  // Each event sampled at its own rate: at least one sample per 10 µs of its length.
+  for (const SlipEvent& event : events) {
+    const auto inside = std::count_if(samples.begin(), samples.end(), [&event](const EventFlag& sample) {
+      return sample.time >= event.onset_time && sample.time <= event.end_time;
+    });
+    EXPECT_GE(inside, std::floor((event.end_time - event.onset_time) / (1e-5 + dt))) << event.index;
+  }
+  EXPECT_GT(in_events, 0);
+  EXPECT_GT(idle_gaps, 0);
+  // Between events no faster than the idle rate: one sample per millisecond, and one more per event.
+  EXPECT_LE(samples.size() - in_events, driver.simulation().time() * 1e3 + events.size() + 1);
+}
+
 TEST(RunDriver, PacedRunsEndTheirJumpsAtTheCamerasFrames) {
   // Cut at frames, every idle frame of the stuck block is a jump's end, at its time on the clock; uncut,
   // one jump covers the whole 0.1 s and its frames are interpolated.
@@ -120,7 +176,8 @@ TEST(RunDriver, PacedRunsEndTheirJumpsAtTheCamerasFrames) {
     options.cut_jumps_at_frames = cut;
     RunDriver driver(scene, requireValidScene(scene), options);
     std::vector<InterfaceFrame> frames;
-    driver.add(std::make_unique<CameraStream>(1e5, 100.0, [&frames](const InterfaceFrame& f) { frames.push_back(f); }));
+    driver.add(std::make_unique<CameraStream>(SampleRates{1e5, 100.0},
+                                              [&frames](const InterfaceFrame& f) { frames.push_back(f); }));
     driver.run();
     ASSERT_EQ(frames.size(), 10U) << cut;
     for (std::size_t k = 0; k < frames.size(); ++k) EXPECT_NEAR(frames[k].time, (k + 1) * 0.01, 1e-12);

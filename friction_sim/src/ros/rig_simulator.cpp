@@ -103,11 +103,13 @@ const LiveSettings kLiveSettings = {
     {{"real_time_factor", &SimulatorConfig::real_time_factor, &SimulatorOptions::real_time_factor},
      {"load_cell_rate", &SimulatorConfig::load_cell_rate, &SimulatorOptions::load_cell_rate},
      {"gauge_rate", &SimulatorConfig::gauge_rate, &SimulatorOptions::gauge_rate},
+     {"gauge_idle_rate", &SimulatorConfig::gauge_idle_rate, &SimulatorOptions::gauge_idle_rate},
      {"interface_rate", &SimulatorConfig::interface_rate, &SimulatorOptions::interface_rate},
      {"interface_idle_rate", &SimulatorConfig::interface_idle_rate, &SimulatorOptions::interface_idle_rate},
      {"stage_state_rate", &SimulatorConfig::stage_state_rate, &SimulatorOptions::stage_state_rate},
      {"clock_rate", &SimulatorConfig::clock_rate, &SimulatorOptions::clock_rate},
      {"lattice_rate", &SimulatorConfig::lattice_rate, &SimulatorOptions::lattice_rate},
+     {"lattice_idle_rate", &SimulatorConfig::lattice_idle_rate, &SimulatorOptions::lattice_idle_rate},
      {"snapshot_rate", &SimulatorConfig::snapshot_rate, &SimulatorOptions::snapshot_rate}}};
 
 std::vector<std::string> validateOptions(const SimulatorOptions& o) {
@@ -247,11 +249,12 @@ void RigSimulator::addStreams(RunDriver& driver) {
   gauges_stream_ = nullptr;
   if (scene_.model == ModelKind::Lattice2D) {
     gauges_stream_ = &driver.add(std::make_unique<SampledStream<GaugeProfile>>(
-        o.gauge_rate, Sampling::AtSteps, [](const Simulation& s) { return s.gaugeProfile(); },
+        SampleRates{o.gauge_rate, o.gauge_idle_rate}, Sampling::AtSteps,
+        [](const Simulation& s) { return s.gaugeProfile(); },
         [this](const GaugeProfile& gauges) { emit(gauges_pub_, "strain_gauges", toMsg(gauges, options_.frame_id)); }));
   }
-  camera_stream_ = &driver.add(
-      std::make_unique<CameraStream>(o.interface_rate, o.interface_idle_rate, [this](const InterfaceFrame& shot) {
+  camera_stream_ = &driver.add(std::make_unique<CameraStream>(
+      SampleRates{o.interface_rate, o.interface_idle_rate}, [this](const InterfaceFrame& shot) {
         emit(interface_pub_, "interface", toMsg(shot, frame_index_++, options_.frame_id));
       }));
   driver.add(std::make_unique<EventStream>(nullptr, [this](const Simulation&, const SlipEvent& event) {
@@ -262,7 +265,8 @@ void RigSimulator::addStreams(RunDriver& driver) {
       o.stage_state_rate, Sampling::AtSteps, stageState,
       [this](const StageStateReading& reading) { publishStageState(reading); }));
   lattice_stream_ = &driver.add(std::make_unique<SampledStream<LatticeSnapshot>>(
-      o.lattice_rate, Sampling::AtSteps, [](const Simulation& s) { return s.snapshot(); },
+      SampleRates{o.lattice_rate, o.lattice_idle_rate}, Sampling::AtSteps,
+      [](const Simulation& s) { return s.snapshot(); },
       [this](const LatticeSnapshot& snapshot) { emit(lattice_pub_, "lattice", toMsg(snapshot, options_.frame_id)); }));
 }
 
@@ -292,12 +296,12 @@ void RigSimulator::applyLiveSettings(const SimulatorOptions& live) {
   next_snapshot_ = std::min(next_snapshot_, ros::WallTime::now() + ros::WallDuration(1.0 / live.snapshot_rate));
   options_ = live;
   const double now = simulation().time();
-  clock_stream_->setRate(live.clock_rate, now);
-  load_cells_stream_->setRate(live.load_cell_rate, now);
-  if (gauges_stream_) gauges_stream_->setRate(live.gauge_rate, now);
-  camera_stream_->setRates(live.interface_rate, live.interface_idle_rate, now);
-  stage_stream_->setRate(live.stage_state_rate, now);
-  lattice_stream_->setRate(live.lattice_rate, now);
+  clock_stream_->setRates(SampleRates::uniform(live.clock_rate), now);
+  load_cells_stream_->setRates(SampleRates::uniform(live.load_cell_rate), now);
+  if (gauges_stream_) gauges_stream_->setRates({live.gauge_rate, live.gauge_idle_rate}, now);
+  camera_stream_->setRates({live.interface_rate, live.interface_idle_rate}, now);
+  stage_stream_->setRates(SampleRates::uniform(live.stage_state_rate), now);
+  lattice_stream_->setRates({live.lattice_rate, live.lattice_idle_rate}, now);
 }
 
 void RigSimulator::advertise() {

@@ -8,12 +8,15 @@
 //   checked as the parameters are, and a bad one is refused with a logged reason, the settings kept.
 //   real_time_factor (double, 0)    simulated seconds per wall second; 0 runs as fast as possible
 //   load_cell_rate (double, 1e4)    Hz of simulated time, load_cells
-//   gauge_rate (double, 1e4)        Hz of simulated time, strain_gauges
+//   gauge_rate (double, 1e5)        Hz of simulated time, strain_gauges during slip events
+//   gauge_idle_rate (double, 1e3)   Hz of simulated time, strain_gauges while all is stuck
 //   interface_rate (double, 1e5)    Hz of simulated time, interface frames during slip events
 //   interface_idle_rate (double, 100)  Hz of simulated time, interface frames while all is stuck
 //   stage_state_rate (double, 1e3)  Hz of simulated time, stage_state
 //   clock_rate (double, 1e4)        Hz of simulated time, /clock
-//   lattice_rate (double, 200)      Hz of simulated time, lattice snapshots (also written to the bag)
+//   lattice_rate (double, 1e4)      Hz of simulated time, lattice snapshots during slip events (also
+//                                   written to the bag)
+//   lattice_idle_rate (double, 50)  Hz of simulated time, lattice snapshots while all is stuck
 //   snapshot_rate (double, 20)      Hz of wall time, extra lattice snapshots while someone watches live
 //   bag (string, "")                write every instrument topic to this bag, independent of subscribers;
 //                                   written as BAG.active (locked: a second rig is refused) and renamed
@@ -47,8 +50,8 @@
 //                                                  simulated time of the step it took effect at: with the
 //                                                  scene, the bag's record of what drove the run (rig_report
 //                                                  writes both out, and friction_run --commands reruns them)
-// Across a fast-forward jump each stream is interpolated on its own grid (the camera at
-// interface_idle_rate): the jump is cut only where a command is due, so that the run is the offline
+// Across a fast-forward jump each stream is interpolated on its own grid (the camera, the gauges and the
+// lattice at their idle rates): the jump is cut only where a command is due, so that the run is the offline
 // runner's, step for step; paced (real_time_factor > 0) also at every interface frame, so that a watcher
 // sees the slider move and a command sent "now" acts within a frame; and while the stage rests with no
 // end in sight (nothing due, no program segment to end), whose jumps would have no end.
@@ -114,12 +117,14 @@ struct SimulatorOptions {
   std::string overrides;                ///< "key=value ..." scene fields to replace
   double real_time_factor = 0.0;        ///< sim s per wall s; 0 = as fast as possible
   double load_cell_rate = 1e4;          ///< Hz, simulated
-  double gauge_rate = 1e4;              ///< Hz, simulated
+  double gauge_rate = 1e5;              ///< Hz, simulated, during events
+  double gauge_idle_rate = 1e3;         ///< Hz, simulated, while all is stuck
   double interface_rate = 1e5;          ///< Hz, simulated, during events
   double interface_idle_rate = 100.0;   ///< Hz, simulated, while all is stuck
   double stage_state_rate = 1e3;        ///< Hz, simulated
   double clock_rate = 1e4;              ///< Hz, simulated
-  double lattice_rate = 200.0;          ///< Hz, simulated
+  double lattice_rate = 1e4;            ///< Hz, simulated, during events
+  double lattice_idle_rate = 50.0;      ///< Hz, simulated, while all is stuck
   double snapshot_rate = 20.0;          ///< Hz, wall
   std::string bag_path;                 ///< "" = no bag
   std::string bag_compression = "lz4";  ///< "lz4", "bz2" or "none": how the bag's chunks are compressed
@@ -139,7 +144,7 @@ struct LiveSetting {
   double SimulatorOptions::*in_options;
 };
 /// The pace, then the rates: read, checked and changed live through this one list.
-using LiveSettings = std::array<LiveSetting, 9>;
+using LiveSettings = std::array<LiveSetting, 11>;
 extern const LiveSettings kLiveSettings;
 
 /// ~wait_for_subscribers parsed: each topic (relative name) with its count; a problem for each bad item.

@@ -54,29 +54,43 @@ struct Instant {
 };
 inline Instant interpolate(const Instant& /*a*/, const Instant& /*b*/, double t) { return {t}; }
 
-/// A stream of readings (any type with a `time` in s and an `interpolate(a, b, t)`) sampled at `rate`
-/// (Hz of simulated time), starting one period in: nothing is measured at t = 0.
+/// A stream's sampling rates (Hz of simulated time): while a slip event runs, and while all sticks. The
+/// lab's fast acquisition runs during events only; the loading between them changes slowly.
+struct SampleRates {
+  double during_events;
+  double idle;
+  /// One rate for both.
+  static SampleRates uniform(double rate) { return {rate, rate}; }
+  double fastest() const { return std::max(during_events, idle); }
+};
+
+/// A stream of readings (any type with a `time` in s and an `interpolate(a, b, t)`) sampled at its rates,
+/// starting one period in: nothing is measured at t = 0. Where the rates differ, an event's first step
+/// brings the next sample within one period of the event rate, and the clock keeps the period of the
+/// state (event or idle) at each sample.
 template <class Reading>
 class SampledStream : public RunStream {
  public:
   using Read = std::function<Reading(const Simulation&)>;
   using Sink = std::function<void(const Reading&)>;
   /// `at_event_boundaries`: also at the end of every step where a slip event starts or ends, off the clock.
-  SampledStream(double rate, Sampling sampling, Read read, Sink sink, bool at_event_boundaries = false)
-      : period_(1.0 / rate),
-        next_(1.0 / rate),
+  SampledStream(SampleRates rates, Sampling sampling, Read read, Sink sink, bool at_event_boundaries = false)
+      : rates_(rates),
+        next_(1.0 / rates.idle),
         sampling_(sampling),
         at_event_boundaries_(at_event_boundaries),
         read_(std::move(read)),
         sink_(std::move(sink)) {}
+  SampledStream(double rate, Sampling sampling, Read read, Sink sink, bool at_event_boundaries = false)
+      : SampledStream(SampleRates::uniform(rate), sampling, std::move(read), std::move(sink), at_event_boundaries) {}
 
   double nextTime() const override { return next_; }
   /// True if the last advance produced a sample.
   bool sampledLast() const { return sampled_last_; }
-  /// A new rate (Hz of simulated time) from simulated time `now` (s): the next sample within a new period.
-  void setRate(double rate, double now) {
-    period_ = 1.0 / rate;
-    next_ = std::min(next_, now + period_);
+  /// New rates from simulated time `now` (s): the next sample within a period of the faster one.
+  void setRates(SampleRates rates, double now) {
+    rates_ = rates;
+    next_ = std::min(next_, now + 1.0 / rates.fastest());
   }
 
   void before(const Simulation& simulation, bool commands_applied) override {
@@ -89,23 +103,25 @@ class SampledStream : public RunStream {
 
   void after(const Simulation& simulation, bool jumped) override {
     sampled_last_ = false;
+    const double period = 1.0 / (simulation.inEvent() ? rates_.during_events : rates_.idle);
     if (jumped || sampling_ == Sampling::Interpolated) {
       Reading end = read_(simulation);
-      for (; next_ <= simulation.time(); next_ += period_) emit(interpolate(before_, end, next_));
+      for (; next_ <= simulation.time(); next_ += period) emit(interpolate(before_, end, next_));
       before_ = std::move(end);
       before_current_ = true;
     }
     if (sampling_ != Sampling::AtSteps) return;
+    if (simulation.inEvent()) next_ = std::min(next_, simulation.time() + period);
     const bool boundary =
         at_event_boundaries_ && (simulation.eventStartedLastStep() || simulation.eventEndedLastStep());
-    if (dueAt(simulation.time()) || boundary) emit(read_(simulation));
+    if (dueAt(simulation.time(), period) || boundary) emit(read_(simulation));
   }
 
  private:
-  /// Moves the clock past `now` on its regular grid; true if a sample was due.
-  bool dueAt(double now) {
+  /// Moves the clock past `now` on its grid of `period`; true if a sample was due.
+  bool dueAt(double now, double period) {
     if (now < next_) return false;
-    next_ += period_ * (std::floor((now - next_) / period_) + 1.0);
+    next_ += period * (std::floor((now - next_) / period) + 1.0);
     return true;
   }
   void emit(const Reading& reading) {
@@ -113,8 +129,8 @@ class SampledStream : public RunStream {
     sampled_last_ = true;
   }
 
-  double period_;  ///< s
-  double next_;    ///< s
+  SampleRates rates_;
+  double next_;  ///< s
   Sampling sampling_;
   bool at_event_boundaries_;
   Read read_;
@@ -125,28 +141,26 @@ class SampledStream : public RunStream {
 };
 
 /// The fast camera: a frame at every step where a node unsticks or an event starts or ends, and otherwise
-/// at `rate` during slip events and `idle_rate` while all sticks (Hz of simulated time; each frame's next
-/// counted from it). Across a jump, where all sticks, interpolated at the idle rate. Jumps cut at frames
-/// end at its next one.
+/// at its rates (each frame's next counted from it). Across a jump, where all sticks, interpolated at the
+/// idle rate. Jumps cut at frames end at its next one.
 class CameraStream : public RunStream {
  public:
   using Sink = std::function<void(const InterfaceFrame&)>;
-  CameraStream(double rate, double idle_rate, Sink sink);
+  CameraStream(SampleRates rates, Sink sink);
   double nextTime() const override { return next_; }
-  /// New rates (Hz of simulated time) from simulated time `now` (s): the next frame within a new period of
-  /// the faster of the two (one frame early at most, where all sticks).
-  void setRates(double rate, double idle_rate, double now) {
-    rate_ = rate;
-    idle_rate_ = idle_rate;
-    next_ = std::min(next_, now + 1.0 / std::max(rate, idle_rate));
+  /// New rates from simulated time `now` (s): the next frame within a period of the faster one (one frame
+  /// early at most, where all sticks).
+  void setRates(SampleRates rates, double now) {
+    rates_ = rates;
+    next_ = std::min(next_, now + 1.0 / rates.fastest());
   }
   bool cutsJumps() const override { return true; }
   void before(const Simulation& simulation, bool commands_applied) override;
   void after(const Simulation& simulation, bool jumped) override;
 
  private:
-  double rate_, idle_rate_;  ///< Hz
-  double next_;              ///< s
+  SampleRates rates_;
+  double next_;  ///< s
   Sink sink_;
   InterfaceFrame before_;
 };

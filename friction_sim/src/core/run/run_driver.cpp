@@ -5,8 +5,8 @@
 
 namespace friction {
 
-CameraStream::CameraStream(double rate, double idle_rate, Sink sink)
-    : rate_(rate), idle_rate_(idle_rate), next_(1.0 / idle_rate), sink_(std::move(sink)) {}
+CameraStream::CameraStream(SampleRates rates, Sink sink)
+    : rates_(rates), next_(1.0 / rates.idle), sink_(std::move(sink)) {}
 
 void CameraStream::before(const Simulation& simulation, bool /*commands_applied*/) {
   if (simulation.mayJump()) before_ = simulation.interfaceFrame();
@@ -16,11 +16,11 @@ void CameraStream::after(const Simulation& simulation, bool jumped) {
   const double t = simulation.time();
   if (jumped) {
     const InterfaceFrame end = simulation.interfaceFrame();
-    for (; next_ <= t; next_ += 1.0 / idle_rate_) sink_(interpolate(before_, end, next_));
+    for (; next_ <= t; next_ += 1.0 / rates_.idle) sink_(interpolate(before_, end, next_));
   }
   if (simulation.interfaceChangedLastStep() || t >= next_) {
     sink_(simulation.interfaceFrame());
-    next_ = t + 1.0 / (simulation.inEvent() ? rate_ : idle_rate_);
+    next_ = t + 1.0 / (simulation.inEvent() ? rates_.during_events : rates_.idle);
   }
 }
 
