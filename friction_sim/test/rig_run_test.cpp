@@ -418,7 +418,7 @@ TEST(FullRun, GaugesAreFastDuringEventsAndSlowBetweenThem) {
   };
   auto onset_between = [&events](double a, double b) {
     return std::any_of(events.begin(), events.end(),
-                       [a, b](const auto& e) { return a < e->onset_time && e->onset_time <= b; });
+                       [a, b](const auto& e) { return a <= e->onset_time && e->onset_time <= b; });
   };
   int fast = 0, slow = 0;
   for (std::size_t k = 0; k + 1 < profiles.size(); ++k) {

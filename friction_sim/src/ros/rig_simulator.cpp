@@ -308,7 +308,7 @@ void RigSimulator::advertise() {
   clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 100);
   // Deep queues: an unpaced jump publishes all its interpolated samples at once (a 0.1 s jump, 10³ load
   // cells), and a full queue drops the oldest, which a subscriber busy elsewhere then never sees. At most
-  // about 10 MB each (a gauge profile is some 1.5 kB, a load cell reading 0.1 kB).
+  // about 10 MB each (a gauge profile is some 1.2 kB, a load cell reading 0.1 kB).
   load_cells_pub_ = nh_.advertise<geometry_msgs::WrenchStamped>("load_cells", 100000);
   gauges_pub_ = nh_.advertise<friction_msgs::StrainGaugeProfile>("strain_gauges", 10000);
   interface_pub_ = nh_.advertise<friction_msgs::InterfaceState>("interface", 10000);

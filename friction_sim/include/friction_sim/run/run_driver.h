@@ -65,9 +65,10 @@ struct SampleRates {
 };
 
 /// A stream of readings (any type with a `time` in s and an `interpolate(a, b, t)`) sampled at its rates,
-/// starting one period in: nothing is measured at t = 0. Where the rates differ, an event's first step
-/// brings the next sample within one period of the event rate, and the clock keeps the period of the
-/// state (event or idle) at each sample.
+/// starting one idle period in: nothing is measured at t = 0. Where the rates differ, a stream sampled at
+/// steps has its next sample brought within one event period by an event's first step, and its clock
+/// keeps the period of the state (event or idle) at each sample; across a jump, where all sticks, the
+/// idle period.
 template <class Reading>
 class SampledStream : public RunStream {
  public:
@@ -87,10 +88,11 @@ class SampledStream : public RunStream {
   double nextTime() const override { return next_; }
   /// True if the last advance produced a sample.
   bool sampledLast() const { return sampled_last_; }
-  /// New rates from simulated time `now` (s): the next sample within a period of the faster one.
+  /// New rates from simulated time `now` (s): the next sample within an idle period (an event's next step
+  /// brings it within an event period).
   void setRates(SampleRates rates, double now) {
     rates_ = rates;
-    next_ = std::min(next_, now + 1.0 / rates.fastest());
+    next_ = std::min(next_, now + 1.0 / rates.idle);
   }
 
   void before(const Simulation& simulation, bool commands_applied) override {
@@ -103,10 +105,13 @@ class SampledStream : public RunStream {
 
   void after(const Simulation& simulation, bool jumped) override {
     sampled_last_ = false;
-    const double period = 1.0 / (simulation.inEvent() ? rates_.during_events : rates_.idle);
+    const double idle_period = 1.0 / rates_.idle;
+    const double period = simulation.inEvent() ? 1.0 / rates_.during_events : idle_period;
     if (jumped || sampling_ == Sampling::Interpolated) {
+      // A jump moves a stuck interface, also where it ends at an event's first slip: the idle clock.
+      const double grid = jumped ? idle_period : period;
       Reading end = read_(simulation);
-      for (; next_ <= simulation.time(); next_ += period) emit(interpolate(before_, end, next_));
+      for (; next_ <= simulation.time(); next_ += grid) emit(interpolate(before_, end, next_));
       before_ = std::move(end);
       before_current_ = true;
     }
