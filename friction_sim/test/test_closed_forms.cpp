@@ -229,6 +229,29 @@ TEST(StabilityBounds, LatticeBoundsHoldAndAreCloseOnFineLattices) {
   }
 }
 
+// The bound reads each node's diagonal block, which the models give without assembling the matrix: the
+// same numbers, to the last bit, as the assembled matrix's entries.
+TEST(StabilityBounds, NodeBlocksAreTheAssembledMatrixsEntries) {
+  Scene mattress = testing::pmmaScene(29, 16);
+  mattress.load.top = TopLoadKind::SpringMattress;
+  Lattice2D lattice(mattress);
+  lattice.connectPusher(Vector::Zero(lattice.dofCount()));
+  const Chain1D chain(loadScene(testing::scenePath("pmma_1d_side")));
+  for (const Model* model : std::initializer_list<const Model*>{&lattice, &chain}) {
+    const SparseMatrix stiffness = model->stiffnessMatrix();
+    const NodeStiffness blocks = model->nodeStiffness();
+    const int nodes = static_cast<int>(blocks.xx.size());
+    ASSERT_EQ(nodes * model->componentsPerNode(), model->dofCount());
+    for (int node = 0; node < nodes; ++node) {
+      ASSERT_EQ(blocks.xx[node], stiffness.coeff(node, node)) << node;
+      if (model->componentsPerNode() == 2) {
+        ASSERT_EQ(blocks.zz[node], stiffness.coeff(nodes + node, nodes + node)) << node;
+        ASSERT_EQ(blocks.xz[node], stiffness.coeff(node, nodes + node)) << node;
+      }
+    }
+  }
+}
+
 TEST(Conservation, VerletEnergyErrorStaysBoundedOverAMillionSteps) {
   const Scene scene = chainScene(8, 0.0);
   Chain1D chain(scene);

@@ -40,6 +40,7 @@ class Chain1D : public Model {
   double elasticEnergy(const Vector& u, double stage_position) const override;
   double externalWork(const Vector&, const Vector&) const override { return 0.0; }
   SparseMatrix stiffnessMatrix() const override;
+  NodeStiffness nodeStiffness() const override;
   /// Nothing: a block's normal force is prescribed by the loads, not carried by a contact spring.
   void releaseContact(SparseMatrix&, int) const override {}
   SparseMatrix dampingMatrix() const override;
@@ -66,6 +67,12 @@ class Chain1D : public Model {
   void updateDrivingStiffness();
   /// The largest eigenvalue of the free chain's unit-coupling Laplacian.
   double chainLaplacianTop() const;
+  /// Adds the stiffness matrix's entries, add(row, col, value), to a matrix being assembled.
+  template <class Add>
+  void addStiffness(Add&& add) const {
+    addNeighbourCoupling(add, k_);
+    for (int i = 0; i < n_; ++i) add(i, i, driving_stiffness_[i]);
+  }
   /// Adds the coupling `coefficient` (N/m or kg/s) of every neighbour pair to a matrix being assembled.
   template <class Add>
   void addNeighbourCoupling(Add&& add, double coefficient) const {

@@ -56,6 +56,7 @@ class Lattice2D : public Model {
   double elasticEnergy(const Vector& u, double stage_position) const override;
   double externalWork(const Vector& u_from, const Vector& u_to) const override;
   SparseMatrix stiffnessMatrix() const override;
+  NodeStiffness nodeStiffness() const override;
   /// The foundation's k_f on the node's u_z.
   void releaseContact(SparseMatrix& stiffness, int node) const override;
   SparseMatrix dampingMatrix() const override;
@@ -88,6 +89,9 @@ class Lattice2D : public Model {
   std::array<double, 3> cellStress(const Vector& u, int i, int j) const;
 
  private:
+  /// Adds the stiffness matrix's entries, add(row, col, value), to a matrix being assembled.
+  template <class Add>
+  void addStiffness(Add&& add) const;
   /// One family of bonds: all springs from node (i, j) to (i + di, j + dj).
   struct BondFamily {
     int di, dj;

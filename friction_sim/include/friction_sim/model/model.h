@@ -30,6 +30,28 @@ SparseMatrix assembleSparse(int size, int entries_per_column, Fill&& fill) {
   return matrix;
 }
 
+/// The diagonal block of a stiffness matrix at each node: 2 × 2 (xx, zz, xz) in 2D, 1 × 1 (xx) for the
+/// chain, whose zz and xz are empty.
+struct NodeStiffness {
+  Vector xx, zz, xz;  ///< N/m, per node
+};
+
+/// The node blocks of the matrix that assembleSparse(nodes · components, ..., fill) would give, summed in
+/// the same order, without the matrix: degree of freedom d is node d's x, nodes + d node d's z.
+template <class Fill>
+NodeStiffness collectNodeStiffness(int nodes, int components, Fill&& fill) {
+  const int planar = components == 2 ? nodes : 0;
+  NodeStiffness blocks{Vector::Zero(nodes), Vector::Zero(planar), Vector::Zero(planar)};
+  fill([&blocks, nodes, planar](int row, int col, double value) {
+    if (row == col) {
+      (row < nodes ? blocks.xx[row] : blocks.zz[row - nodes]) += value;
+    } else if (planar > 0 && col == row + nodes) {
+      blocks.xz[row] += value;
+    }
+  });
+  return blocks;
+}
+
 /// What one force evaluation produces; friction is not included.
 struct ForceEvaluation {
   Vector force;                ///< N, per degree of freedom
@@ -125,6 +147,9 @@ class Model {
 
   /// Stiffness matrix linearised about the rest state, including foundation, pusher and top springs.
   virtual SparseMatrix stiffnessMatrix() const = 0;
+  /// The node blocks of stiffnessMatrix(), equal to its entries, without assembling it (the stability
+  /// bound reads no more).
+  virtual NodeStiffness nodeStiffness() const = 0;
   /// Takes out of `stiffness` (the matrix above) the contact stiffness of interface node `node`, for an
   /// equilibrium in which that node is off the track.
   virtual void releaseContact(SparseMatrix& stiffness, int node) const = 0;

@@ -188,10 +188,11 @@ double Chain1D::elasticEnergy(const Vector& u, double stage_position) const {
 }
 
 SparseMatrix Chain1D::stiffnessMatrix() const {
-  return assembleSparse(n_, 3, [this](auto&& add) {
-    addNeighbourCoupling(add, k_);
-    for (int i = 0; i < n_; ++i) add(i, i, driving_stiffness_[i]);
-  });
+  return assembleSparse(n_, 3, [this](auto&& add) { addStiffness(add); });
+}
+
+NodeStiffness Chain1D::nodeStiffness() const {
+  return collectNodeStiffness(n_, 1, [this](auto&& add) { addStiffness(add); });
 }
 
 SparseMatrix Chain1D::dampingMatrix() const {

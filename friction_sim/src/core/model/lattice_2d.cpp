@@ -368,30 +368,37 @@ double Lattice2D::externalWork(const Vector& u_from, const Vector& u_to) const {
   return -normal_force_ / nx_ * sum;
 }
 
-SparseMatrix Lattice2D::stiffnessMatrix() const {
+template <class Add>
+void Lattice2D::addStiffness(Add&& add) const {
   const Vector anchors = anchorStiffness();
-  // A node and its eight neighbours, two components each.
-  return assembleSparse(2 * n_, 18, [this, &anchors](auto&& add) {
-    for (const BondFamily& family : families_) {
-      const double e[2] = {family.ex, family.ez};
-      forEachBond(family, [&](int a, int b) {
-        const int dofs_a[2] = {xDof(a), zDof(a)};
-        const int dofs_b[2] = {xDof(b), zDof(b)};
-        for (int p = 0; p < 2; ++p) {
-          for (int q = 0; q < 2; ++q) {
-            const double kpq = family.stiffness * e[p] * e[q];
-            add(dofs_a[p], dofs_a[q], kpq);
-            add(dofs_b[p], dofs_b[q], kpq);
-            add(dofs_a[p], dofs_b[q], -kpq);
-            add(dofs_b[p], dofs_a[q], -kpq);
-          }
+  for (const BondFamily& family : families_) {
+    const double e[2] = {family.ex, family.ez};
+    forEachBond(family, [&](int a, int b) {
+      const int dofs_a[2] = {xDof(a), zDof(a)};
+      const int dofs_b[2] = {xDof(b), zDof(b)};
+      for (int p = 0; p < 2; ++p) {
+        for (int q = 0; q < 2; ++q) {
+          const double kpq = family.stiffness * e[p] * e[q];
+          add(dofs_a[p], dofs_a[q], kpq);
+          add(dofs_b[p], dofs_b[q], kpq);
+          add(dofs_a[p], dofs_b[q], -kpq);
+          add(dofs_b[p], dofs_a[q], -kpq);
         }
-      });
-    }
-    for (int dof = 0; dof < 2 * n_; ++dof) {
-      if (anchors[dof] != 0.0) add(dof, dof, anchors[dof]);
-    }
-  });
+      }
+    });
+  }
+  for (int dof = 0; dof < 2 * n_; ++dof) {
+    if (anchors[dof] != 0.0) add(dof, dof, anchors[dof]);
+  }
+}
+
+SparseMatrix Lattice2D::stiffnessMatrix() const {
+  // A node and its eight neighbours, two components each.
+  return assembleSparse(2 * n_, 18, [this](auto&& add) { addStiffness(add); });
+}
+
+NodeStiffness Lattice2D::nodeStiffness() const {
+  return collectNodeStiffness(n_, 2, [this](auto&& add) { addStiffness(add); });
 }
 
 Vector Lattice2D::anchorStiffness() const {

@@ -109,14 +109,14 @@ double blockTop(double d0, double d1, double e) { return 0.5 * (d0 + d1) + std::
 /// blocks of its two nodes, so uᵀKu ≤ Σ_nodes u_iᵀ(2B_ii + A_ii)u_i and λ_max(K) ≤ max_i λ_max(2K_ii − A_ii).
 /// At an interior node of the lattice this is 6k, the infinite lattice's top; at its edges nodes have
 /// fewer bonds, which leaves room for the anchors there.
-double nodeByNodeBound(const SparseMatrix& stiffness, const Vector& anchors, int components) {
-  const int nodes = static_cast<int>(anchors.size()) / components;
+double nodeByNodeBound(const NodeStiffness& blocks, const Vector& anchors) {
+  const int nodes = static_cast<int>(blocks.xx.size());
+  const bool planar = blocks.zz.size() > 0;
   double bound = 0.0;
   for (int node = 0; node < nodes; ++node) {
-    const int x = node, z = nodes + node;
-    auto doubled = [&](int dof) { return 2.0 * stiffness.coeff(dof, dof) - anchors[dof]; };
+    const double x = 2.0 * blocks.xx[node] - anchors[node];
     bound =
-        std::max(bound, components == 1 ? doubled(x) : blockTop(doubled(x), doubled(z), 2.0 * stiffness.coeff(x, z)));
+        std::max(bound, planar ? blockTop(x, 2.0 * blocks.zz[node] - anchors[nodes + node], 2.0 * blocks.xz[node]) : x);
   }
   return bound;
 }
@@ -146,17 +146,18 @@ double stabilityLimit(IntegratorKind kind, double omega_max, double damping_rate
 }
 
 ModeBounds modeBounds(const Model& model, double interfacial_stiffness) {
-  SparseMatrix stiffness = model.stiffnessMatrix();
+  NodeStiffness blocks = model.nodeStiffness();
   Vector anchors = model.anchorStiffness();
+  const int nodes = static_cast<int>(blocks.xx.size());
   for (int node = 0; node < model.interfaceNodeCount(); ++node) {
     const int dof = model.interfaceDof(node);
-    stiffness.coeffRef(dof, dof) += interfacial_stiffness;
+    (dof < nodes ? blocks.xx[dof] : blocks.zz[dof - nodes]) += interfacial_stiffness;
     anchors[dof] += interfacial_stiffness;
   }
   // Two bounds, each close where the other is loose: the bonds' closed form plus the largest anchor
   // (the anchors are a diagonal matrix), and the node-by-node bound, which sees where the anchors are.
-  const double stiffness_bound = std::min(model.bondStiffnessBound() + anchors.maxCoeff(),
-                                          nodeByNodeBound(stiffness, anchors, model.componentsPerNode()));
+  const double stiffness_bound =
+      std::min(model.bondStiffnessBound() + anchors.maxCoeff(), nodeByNodeBound(blocks, anchors));
   ModeBounds bounds;
   bounds.omega_max = std::sqrt(stiffness_bound / model.nodeMass());
   bounds.damping_rate = model.dampingBound() / model.nodeMass();
