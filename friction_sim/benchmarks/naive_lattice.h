@@ -24,8 +24,6 @@ class NaiveLattice {
   NaiveLattice(int nx, int nz, double spacing, double k, double eta, double mass)
       : nx_(nx), nz_(nz), spacing_(spacing), k_(k), eta_(eta), mass_(mass), nodes_(static_cast<std::size_t>(nx) * nz) {}
 
-  int nodesX() const { return nx_; }
-  int nodesZ() const { return nz_; }
   Node& node(int i, int j) { return nodes_[static_cast<std::size_t>(j) * nx_ + i]; }
   const Node& node(int i, int j) const { return nodes_[static_cast<std::size_t>(j) * nx_ + i]; }
 

@@ -240,7 +240,7 @@ TEST(SimulatorOptions, LiveSettingsStartFromTheParametersDefaults) {
   const SimulatorConfig config = SimulatorConfig::__getDefault__();
   const SimulatorOptions options;
   for (const LiveSetting& setting : kLiveSettings) EXPECT_EQ(config.*setting.in_config, options.*setting.in_options);
-  // Every live setting is one of the options validateOptions checks: a change it refuses is refused live.
+  // Each live setting refuses a negative value, as its parameter does: a change refused live names it.
   for (const LiveSetting& setting : kLiveSettings) {
     SimulatorOptions bad = options;
     bad.scene_path = "scene.yaml";

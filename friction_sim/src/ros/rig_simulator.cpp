@@ -99,18 +99,24 @@ std::vector<std::pair<std::string, int>> parseAwaitedSubscribers(const std::stri
   return awaited;
 }
 
+/// A publish rate: a live setting that allows only rates > 0.
+constexpr LiveSetting rate(const char* name, double SimulatorConfig::*in_config, double SimulatorOptions::*in_options) {
+  return {name, in_config, in_options, false, "a rate > 0 Hz"};
+}
+
 const LiveSettings kLiveSettings = {
-    {{"real_time_factor", &SimulatorConfig::real_time_factor, &SimulatorOptions::real_time_factor},
-     {"load_cell_rate", &SimulatorConfig::load_cell_rate, &SimulatorOptions::load_cell_rate},
-     {"gauge_rate", &SimulatorConfig::gauge_rate, &SimulatorOptions::gauge_rate},
-     {"gauge_idle_rate", &SimulatorConfig::gauge_idle_rate, &SimulatorOptions::gauge_idle_rate},
-     {"interface_rate", &SimulatorConfig::interface_rate, &SimulatorOptions::interface_rate},
-     {"interface_idle_rate", &SimulatorConfig::interface_idle_rate, &SimulatorOptions::interface_idle_rate},
-     {"stage_state_rate", &SimulatorConfig::stage_state_rate, &SimulatorOptions::stage_state_rate},
-     {"clock_rate", &SimulatorConfig::clock_rate, &SimulatorOptions::clock_rate},
-     {"lattice_rate", &SimulatorConfig::lattice_rate, &SimulatorOptions::lattice_rate},
-     {"lattice_idle_rate", &SimulatorConfig::lattice_idle_rate, &SimulatorOptions::lattice_idle_rate},
-     {"snapshot_rate", &SimulatorConfig::snapshot_rate, &SimulatorOptions::snapshot_rate}}};
+    {{"real_time_factor", &SimulatorConfig::real_time_factor, &SimulatorOptions::real_time_factor, true,
+      ">= 0 (0 = as fast as possible)"},
+     rate("load_cell_rate", &SimulatorConfig::load_cell_rate, &SimulatorOptions::load_cell_rate),
+     rate("gauge_rate", &SimulatorConfig::gauge_rate, &SimulatorOptions::gauge_rate),
+     rate("gauge_idle_rate", &SimulatorConfig::gauge_idle_rate, &SimulatorOptions::gauge_idle_rate),
+     rate("interface_rate", &SimulatorConfig::interface_rate, &SimulatorOptions::interface_rate),
+     rate("interface_idle_rate", &SimulatorConfig::interface_idle_rate, &SimulatorOptions::interface_idle_rate),
+     rate("stage_state_rate", &SimulatorConfig::stage_state_rate, &SimulatorOptions::stage_state_rate),
+     rate("clock_rate", &SimulatorConfig::clock_rate, &SimulatorOptions::clock_rate),
+     rate("lattice_rate", &SimulatorConfig::lattice_rate, &SimulatorOptions::lattice_rate),
+     rate("lattice_idle_rate", &SimulatorConfig::lattice_idle_rate, &SimulatorOptions::lattice_idle_rate),
+     rate("snapshot_rate", &SimulatorConfig::snapshot_rate, &SimulatorOptions::snapshot_rate)}};
 
 std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   std::vector<std::string> problems;
@@ -120,11 +126,8 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   if (o.scene_path.empty()) problems.push_back("~scene: no value; allowed: the path of a scene YAML file");
   for (const LiveSetting& setting : kLiveSettings) {
     const double value = o.*setting.in_options;
-    if (setting.in_options == &SimulatorOptions::real_time_factor) {
-      require(std::isfinite(value) && value >= 0.0, setting.name, value, ">= 0 (0 = as fast as possible)");
-    } else {
-      require(std::isfinite(value) && value > 0.0, setting.name, value, "a rate > 0 Hz");
-    }
+    require(std::isfinite(value) && (value > 0.0 || (setting.zero_allowed && value == 0.0)), setting.name, value,
+            setting.allowed);
   }
   if (o.frame_id.empty()) problems.push_back("~frame_id: empty; allowed: a frame name such as 'slider'");
   if (!bagCompression(o.bag_compression)) {

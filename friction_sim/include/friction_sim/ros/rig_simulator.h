@@ -136,12 +136,14 @@ struct SimulatorOptions {
 };
 
 using SimulatorConfig = friction_sim::SimulatorConfig;
-/// A setting dynamic_reconfigure changes live (cfg/Simulator.cfg): its parameter's name and its field in
-/// the config and in the options.
+/// A setting dynamic_reconfigure changes live (cfg/Simulator.cfg): its parameter's name, its field in the
+/// config and in the options, and the values it allows (finite, > 0, or also 0 where `zero_allowed`).
 struct LiveSetting {
   const char* name;
   double SimulatorConfig::*in_config;
   double SimulatorOptions::*in_options;
+  bool zero_allowed;
+  const char* allowed;
 };
 /// The pace, then the rates: read, checked and changed live through this one list.
 using LiveSettings = std::array<LiveSetting, 11>;
