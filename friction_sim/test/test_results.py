@@ -137,6 +137,16 @@ class ResultsTest(unittest.TestCase):
         np.testing.assert_allclose(run.gauges.sigma_xx[:, 0], np.arange(1, 101))
         np.testing.assert_allclose(run.gauges.time, np.arange(1, 101) * 1e-3)
 
+    def test_a_counting_column_with_a_missing_cell_reads_as_numbers(self):
+        path = os.path.join(self.work, "old_events.csv")
+        with open(path, "w", newline="") as handle:
+            csv.writer(handle).writerows([["index", "front_fits_left_out", "phase"], ["0", "nan", "loading"],
+                                          ["1", "3", "loading"]])
+        table = results.read_csv(path)
+        self.assertEqual(table["index"].dtype, int)
+        np.testing.assert_array_equal(table["front_fits_left_out"], [np.nan, 3.0])
+        self.assertEqual(table["phase"].tolist(), ["loading", "loading"])
+
     @unittest.skipUnless(__import__("importlib").util.find_spec("pandas"), "pandas is not installed")
     def test_a_table_becomes_a_dataframe(self):
         frame = results.load(self.bag).events.to_dataframe()

@@ -81,13 +81,15 @@ INTEGER_COLUMNS = {"index", "event", "node", "global", "unfinished", "front_fits
 
 
 def _column(name, texts):
-    """A column's text cells: ints for INTEGER_COLUMNS, floats ("nan" included) for the rest, str where
-    a cell is not a number (phase, command)."""
-    kind = int if name in INTEGER_COLUMNS else float
-    try:
-        return np.array([kind(t) for t in texts], dtype=kind)
-    except ValueError:
-        return np.array(texts, dtype=str)
+    """A column's text cells: ints for INTEGER_COLUMNS, floats ("nan" included) for the rest and for a
+    counting column with a missing ("nan") cell, str where a cell is not a number (phase, command)."""
+    kinds = (int, float) if name in INTEGER_COLUMNS else (float,)
+    for kind in kinds:
+        try:
+            return np.array([kind(t) for t in texts], dtype=kind)
+        except ValueError:
+            pass
+    return np.array(texts, dtype=str)
 
 
 def read_csv(path):
