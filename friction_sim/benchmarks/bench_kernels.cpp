@@ -95,6 +95,22 @@ BENCHMARK_CAPTURE(latticeStep, geometric, SpringForm::Geometric)
     ->Args({1001, 1001})
     ->Unit(benchmark::kMicrosecond);
 
+/// The same lattice with each step's sweep split into blocks of rows on state.range(2) threads (one step
+/// per sweep then): against latticeStep (one thread) at the same size, what the threads gain.
+void latticeStepOnThreads(benchmark::State& state) {
+  Simulation& simulation = reusedLattice(state, SpringForm::Geometric);
+  simulation.setThreads(static_cast<int>(state.range(2)));
+  advanceAndCount(state, simulation, static_cast<double>(state.range(0) * state.range(1)), "ns_per_node_step");
+  simulation.setThreads(1);
+}
+BENCHMARK(latticeStepOnThreads)
+    ->Args({57, 31, 2})
+    ->Args({225, 121, 2})
+    ->Args({449, 241, 2})
+    ->Args({1001, 1001, 2})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
 /// The same lattice stepped one step per advance, each step a sweep of its own: what sweeping several
 /// steps at once saves.
 void latticeStepOneAtATime(benchmark::State& state) {

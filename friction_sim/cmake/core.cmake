@@ -2,6 +2,8 @@
 # Included by CMakeLists.txt both in a catkin build and in a plain CMake build (FRICTION_SIM_CORE_ONLY).
 find_package(Eigen3 REQUIRED)
 find_package(yaml-cpp REQUIRED)
+# Threads for the large lattices' force sweeps (Lattice2D::setThreads).
+find_package(OpenMP REQUIRED COMPONENTS CXX)
 # CHOLMOD (SuiteSparse): supernodal Cholesky with nested-dissection ordering keeps the static solves of
 # large lattices within memory (Eigen's simplicial LDLT needed > 3 GB at 10^6 nodes).
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
@@ -52,7 +54,7 @@ endif()
 # The friction loop records each node's force as it turns it into an acceleration; GCC would split
 # that record off into a memcpy call, a second pass over the forces and a call per strip.
 set_source_files_properties(src/core/contact/contact_interface.cpp PROPERTIES COMPILE_OPTIONS -fno-tree-loop-distribute-patterns)
-target_link_libraries(friction_sim_core PUBLIC yaml-cpp ${CHOLMOD_LIBRARY})
+target_link_libraries(friction_sim_core PUBLIC yaml-cpp ${CHOLMOD_LIBRARY} PRIVATE OpenMP::OpenMP_CXX)
 # Calls between the core's own source files bind inside the library too, without the PLT.
 target_link_options(friction_sim_core PRIVATE -Wl,-Bsymbolic-functions)
 

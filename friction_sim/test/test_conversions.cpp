@@ -219,14 +219,17 @@ TEST(SimulatorOptions, EveryBadParameterIsNamedWithValueAndRange) {
   options.load_cell_rate = 0.0;
   options.overrides = "pusher.height=0.01 broken";
   options.bag_compression = "zip";
+  options.threads = 0;
   const auto problems = validateOptions(options);
-  ASSERT_EQ(problems.size(), 5u);
+  ASSERT_EQ(problems.size(), 6u);
   EXPECT_NE(problems[0].find("~scene"), std::string::npos);
   EXPECT_NE(problems[1].find("~real_time_factor: value -1"), std::string::npos);
   EXPECT_NE(problems[2].find("~load_cell_rate: value 0"), std::string::npos);
   EXPECT_NE(problems[3].find("~bag_compression: value 'zip' is not allowed; allowed: lz4, bz2, none"),
             std::string::npos);
   EXPECT_NE(problems[4].find("~overrides: item 'broken'"), std::string::npos);
+  EXPECT_NE(problems[5].find("~threads: value 0 is not allowed; allowed: a whole number from 1"), std::string::npos)
+      << problems[5];
   std::vector<std::string> ignored;
   const auto overrides = parseOverrides("pusher.height=0.01  stop.global_events=3", ignored);
   ASSERT_EQ(overrides.size(), 2u);

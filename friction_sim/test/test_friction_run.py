@@ -53,10 +53,31 @@ class FrictionRunCommandLineTest(unittest.TestCase):
         self.assertIn("unknown argument '--sett'", message)
 
     def test_an_option_missing_its_value_is_named(self):
-        for option in ["--set", "--out", "--commands", "--protocol"]:
+        for option in ["--set", "--out", "--commands", "--protocol", "--threads"]:
             status, message = self.refusal(SCENE, option)
             self.assertEqual(status, 2, option)
             self.assertIn("%s needs a value" % option, message)
+
+    def test_a_thread_count_that_is_not_a_whole_number_from_one_is_named(self):
+        for threads in ["0", "-2", "two", "1.5"]:
+            status, message = self.refusal(SCENE, "--out", self.out, "--threads", threads)
+            self.assertEqual(status, 2, threads)
+            self.assertIn("--threads %s: allowed: a whole number from 1" % threads, message)
+
+    def test_threads_give_the_same_results_to_the_last_digit(self):
+        # The default slider at 4 mm/s to its first global event (seven events), its sweeps on two threads.
+        scene = os.path.join(ROOT, "friction_sim/scenes/pmma_2d.yaml")
+        outputs = {}
+        for threads in ["1", "2"]:
+            out = os.path.join(self.work, "threads_" + threads)
+            done = subprocess.run([self.runner, scene, "--out", out, "--threads", threads, "--set",
+                                   'stage.program=[{"mode":"velocity","speed":4.0e-3}]'],
+                                  capture_output=True, text=True, timeout=120)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            with open(os.path.join(out, "events.csv")) as events, open(os.path.join(out, "summary.txt")) as summary:
+                outputs[threads] = (events.read(), [line for line in summary if "wall time" not in line])
+        self.assertEqual(outputs["1"][0].count("\n"), 8)  # the header and seven events
+        self.assertEqual(outputs["2"], outputs["1"])
 
     def test_a_bad_override_lists_the_field_the_value_and_the_range(self):
         status, message = self.refusal(SCENE, "--out", self.out, "--set", "pusher.height=1")

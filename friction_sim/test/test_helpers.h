@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -87,7 +88,7 @@ class FreeBody : public Dynamics {
 
 /// Records what the evaluation asks of its hooks: each range is displaced when prepared (so a read
 /// before preparation would change the forces), and its forces are copied when finished.
-class RecordingHooks : public StripHooks {
+class RecordingHooks : public StripHooks {  // each dof's records are its own: threads may share it
  public:
   RecordingHooks(Vector& u, const Vector& shift, const Vector& force)
       : u_(u),
@@ -112,7 +113,7 @@ class RecordingHooks : public StripHooks {
   void prepare(int first, int end) override {
     for (int i = first; i < end; ++i) {
       ++prepared_[i];
-      untouched_force_at_prepare_ = untouched_force_at_prepare_ && std::isnan(force_[i]);
+      if (!std::isnan(force_[i])) untouched_force_at_prepare_ = false;
       u_[i] += shift_[i];
     }
   }
@@ -145,7 +146,7 @@ class RecordingHooks : public StripHooks {
   int first_interface_dof_ = 0;
   std::vector<int> prepared_, finished_;
   Vector forces_at_finish_, normal_forces_at_finish_;
-  bool untouched_force_at_prepare_ = true;
+  std::atomic<bool> untouched_force_at_prepare_{true};  ///< threads may prepare strips at once
 };
 
 }  // namespace friction::testing

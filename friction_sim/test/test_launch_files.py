@@ -76,8 +76,9 @@ class LaunchFilesTest(unittest.TestCase):
     def test_multi_machine_runs_the_simulator_remotely_with_every_rig_argument(self):
         config = load("multi_machine.launch", "compute_host:=hpc1", "compute_env:=/opt/rig/scripts/ros_env_loader.sh",
                       "overrides:=pusher.height=0.01", "record:=true", "bag:=/scratch/run.bag",
-                      "real_time_factor:=0.5", "ns:=bench")
+                      "real_time_factor:=0.5", "ns:=bench", "threads:=2")
         self.assertEqual(host(config, "simulator"), "hpc1")
+        self.assertEqual(config.params["/bench/simulator/threads"].value, 2)
         self.assertEqual(node(config, "simulator").namespace, "/bench/")
         for workstation_node in ["controller", "precursor_detector", "rviz"]:
             self.assertEqual(host(config, workstation_node), "localhost", workstation_node)

@@ -619,6 +619,41 @@ TEST(SimulationStrips, FusedVerletStepOfALongChainEqualsTheUnfusedOneBitForBit) 
   expectFusedVerletStepEqualsTheUnfusedOne(chain, 200);
 }
 
+/// Two runs of one scene ended alike: the state, the events, the step count and the energy budget the
+/// same bit for bit.
+void expectTheSameRunBitForBit(const Simulation& a, const Simulation& b) {
+  EXPECT_EQ(a.steps(), b.steps());
+  EXPECT_EQ(a.time(), b.time());
+  EXPECT_EQ(a.stateHash(), b.stateHash());
+  EXPECT_EQ(a.stopReason(), b.stopReason());
+  const EnergyBudget energy_a = a.energy(), energy_b = b.energy();
+  EXPECT_EQ(energy_a.work_in, energy_b.work_in);
+  EXPECT_EQ(energy_a.elastic, energy_b.elastic);
+  EXPECT_EQ(energy_a.kinetic, energy_b.kinetic);
+  EXPECT_EQ(energy_a.friction_dissipation, energy_b.friction_dissipation);
+  EXPECT_EQ(energy_a.viscous_dissipation, energy_b.viscous_dissipation);
+  EXPECT_EQ(a.loadCells().shear_force, b.loadCells().shear_force);
+  EXPECT_EQ(a.loadCells().interface_normal_sum, b.loadCells().interface_normal_sum);
+  EXPECT_EQ(a.events().size(), b.events().size());
+  // NaN where a node did not slip: compared as bits.
+  auto same_bits = [](const std::vector<double>& x, const std::vector<double>& y) {
+    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(double)) == 0;
+  };
+  for (std::size_t e = 0; e < std::min(a.events().size(), b.events().size()); ++e) {
+    const SlipEvent &g = a.events()[e], &s = b.events()[e];
+    EXPECT_EQ(g.onset_time, s.onset_time);
+    EXPECT_EQ(g.end_time, s.end_time);
+    EXPECT_EQ(g.onset_shear_force, s.onset_shear_force);
+    EXPECT_EQ(g.onset_normal_force, s.onset_normal_force);
+    EXPECT_EQ(g.end_shear_force, s.end_shear_force);
+    EXPECT_EQ(g.mean_shear_force, s.mean_shear_force);
+    EXPECT_EQ(g.global, s.global);
+    EXPECT_EQ(g.node_slip, s.node_slip);
+    EXPECT_TRUE(same_bits(g.first_unstick_time, s.first_unstick_time));
+    EXPECT_TRUE(same_bits(g.front_speed, s.front_speed));
+  }
+}
+
 /// Runs `scene` to its end twice: one step per advance, and several where advance may take them, in
 /// groups that end before "samples" every 7 steps. The state, the events, the step count and the energy
 /// budget must be the same bit for bit.
@@ -644,36 +679,7 @@ Groups expectGroupedStepsGiveTheRunOfSingleSteps(const Scene& scene) {
       EXPECT_LT(grouped.time(), next_sample);
     }
   }
-  EXPECT_EQ(grouped.steps(), single.steps());
-  EXPECT_EQ(grouped.time(), single.time());
-  EXPECT_EQ(grouped.stateHash(), single.stateHash());
-  EXPECT_EQ(grouped.stopReason(), single.stopReason());
-  const EnergyBudget a = grouped.energy(), b = single.energy();
-  EXPECT_EQ(a.work_in, b.work_in);
-  EXPECT_EQ(a.elastic, b.elastic);
-  EXPECT_EQ(a.kinetic, b.kinetic);
-  EXPECT_EQ(a.friction_dissipation, b.friction_dissipation);
-  EXPECT_EQ(a.viscous_dissipation, b.viscous_dissipation);
-  EXPECT_EQ(grouped.loadCells().shear_force, single.loadCells().shear_force);
-  EXPECT_EQ(grouped.loadCells().interface_normal_sum, single.loadCells().interface_normal_sum);
-  EXPECT_EQ(grouped.events().size(), single.events().size());
-  // NaN where a node did not slip: compared as bits.
-  auto same_bits = [](const std::vector<double>& a, const std::vector<double>& b) {
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
-  };
-  for (std::size_t e = 0; e < std::min(grouped.events().size(), single.events().size()); ++e) {
-    const SlipEvent &g = grouped.events()[e], &s = single.events()[e];
-    EXPECT_EQ(g.onset_time, s.onset_time);
-    EXPECT_EQ(g.end_time, s.end_time);
-    EXPECT_EQ(g.onset_shear_force, s.onset_shear_force);
-    EXPECT_EQ(g.onset_normal_force, s.onset_normal_force);
-    EXPECT_EQ(g.end_shear_force, s.end_shear_force);
-    EXPECT_EQ(g.mean_shear_force, s.mean_shear_force);
-    EXPECT_EQ(g.global, s.global);
-    EXPECT_EQ(g.node_slip, s.node_slip);
-    EXPECT_TRUE(same_bits(g.first_unstick_time, s.first_unstick_time));
-    EXPECT_TRUE(same_bits(g.front_speed, s.front_speed));
-  }
+  expectTheSameRunBitForBit(grouped, single);
   groups.run_steps = single.steps();
   groups.events = single.events().size();
   return groups;
@@ -712,6 +718,25 @@ TEST(SimulationStrips, GroupedStepsOfALatticeOfSeveralStripsGiveTheSingleSteps) 
   EXPECT_GT(groups.steps, 200);
   EXPECT_EQ(groups.longest, buildModel(scene)->successiveEvaluations());
   EXPECT_EQ(groups.run_steps, 299);
+}
+
+TEST(SimulationThreads, ThreadsGiveTheRunOfOneThreadBitForBit) {
+  // The default slider driven at 4 mm/s to its first global event: fast-forward's jumps, six precursors and
+  // the global event, on one thread in groups of steps, on two and on three one step at a time, each
+  // sweep split into blocks of rows.
+  Scene scene = testing::pmmaScene(57, 31);
+  scene.stage.program = {StageSegment{StageMode::Velocity, 4e-3}};
+  Simulation one(scene);
+  one.run();
+  ASSERT_EQ(one.events().size(), 7u);
+  EXPECT_GT(one.jumps(), 0);
+  for (int threads : {2, 3}) {
+    SCOPED_TRACE(threads);
+    Simulation threaded(scene);
+    threaded.setThreads(threads);
+    threaded.run();
+    expectTheSameRunBitForBit(threaded, one);
+  }
 }
 
 TEST(SimulationStrips, GroupedStepsOfALatticeOfSeveralStripsGiveTheSingleStepsThroughEvents) {

@@ -2,6 +2,7 @@
 // one sweep and keep the hook contract of model.h.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
@@ -18,9 +19,11 @@ namespace {
 /// and kick its velocity when it is finished, against one sweep over the drifted state. The forces and
 /// normal forces must be the same bit for bit: a dof read before it was prepared, or a velocity read
 /// after its dof was finished, would change them. The damping power is a sum taken strip by strip, so
-/// it may differ from the one sweep's in the last digits (`power_tolerance`, relative).
+/// it may differ from the one sweep's in the last digits (`power_tolerance`, relative). The one sweep is
+/// `one_sweep`'s where given (the same model, unthreaded).
 void expectStripsGiveOneSweep(const Model& model, const Vector& u, double stage_position,
-                              const std::vector<int>& strip_sizes, double power_tolerance) {
+                              const std::vector<int>& strip_sizes, double power_tolerance,
+                              const Model* one_sweep = nullptr) {
   const int n = model.dofCount();
   Vector v(n), shift(n), kick(n);
   for (int i = 0; i < n; ++i) {
@@ -29,7 +32,7 @@ void expectStripsGiveOneSweep(const Model& model, const Vector& u, double stage_
     kick[i] = 1e-4 * std::sin(0.7 * i + 0.3);
   }
   ForceEvaluation whole;
-  model.evaluate(u + shift, v, stage_position, whole);
+  (one_sweep ? *one_sweep : model).evaluate(u + shift, v, stage_position, whole);
   ASSERT_GT(whole.shear_force, 0.0);
   const int first_interface_dof = model.interfaceDof(0);
   for (int strip_nodes : strip_sizes) {
@@ -56,9 +59,9 @@ void expectStripsGiveOneSweep(const Model& model, const Vector& u, double stage_
   }
 }
 
-/// The loaded slider at 21 × 11 nodes, with the top load and pusher of `variant`.
-Scene latticeStripScene(int variant) {
-  Scene scene = testing::pmmaScene(21, 11);
+/// The loaded slider at nx × nz nodes, with the top load and pusher of `variant`.
+Scene latticeStripScene(int variant, int nx = 21, int nz = 11) {
+  Scene scene = testing::pmmaScene(nx, nz);
   if (variant == 1) {
     // A spring mattress that holds the top row in x as well, and a pusher band up to the top row.
     scene.load.top = TopLoadKind::SpringMattress;
@@ -93,6 +96,33 @@ TEST(LatticeStrips, StripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {
     // over the whole sweep, so it is the same bit for bit.
     expectStripsGiveOneSweep(lattice, u, 1e-5, {1, 2 * 21, 3 * 21}, 0.0);
   }
+}
+
+TEST(LatticeThreads, BlocksOfRowsOnThreadsGiveTheForcesOfOneSweepBitForBit) {
+  for (int variant : {0, 1}) {
+    SCOPED_TRACE(variant);
+    // 1485 nodes, over the size where threads start; 33 rows are 5 bands of 8 rows, the last of 1.
+    const Scene scene = latticeStripScene(variant, 45, 33);
+    const Lattice2D one_thread(scene);
+    const Vector u = roughDisplacements(one_thread.dofCount(), true);
+    ASSERT_GE(one_thread.nodesX() * one_thread.nodesZ(), Lattice2D::kThreadedNodes);
+    EXPECT_EQ(one_thread.threadedBlocks(), 1);
+    EXPECT_EQ(one_thread.successiveEvaluations(), 3);
+    // More threads than cores, as many as bands (one block per band) and more (a band each, no more).
+    for (int threads : {2, 3, 5, 7}) {
+      SCOPED_TRACE(threads);
+      Lattice2D threaded(scene);
+      threaded.setThreads(threads);
+      EXPECT_EQ(threaded.threadedBlocks(), std::min(threads, 5));
+      EXPECT_EQ(threaded.successiveEvaluations(), 1);
+      // Strips of one row, of several rows, of more rows than a band, and the whole lattice.
+      expectStripsGiveOneSweep(threaded, u, 1e-5, {1, 5 * 45, 10 * 45, threaded.dofCount()}, 0.0, &one_thread);
+    }
+  }
+  // Below the size where threads pay, none are used.
+  Lattice2D small(latticeStripScene(0));
+  small.setThreads(2);
+  EXPECT_EQ(small.threadedBlocks(), 1);
 }
 
 TEST(ChainStrips, SideDrivenStripsGiveTheForcesOfOneSweepAndKeepTheHookContract) {

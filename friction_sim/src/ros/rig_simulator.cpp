@@ -137,6 +137,7 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   parseAwaitedSubscribers(o.wait_for_subscribers, problems);
   require(std::isfinite(o.subscriber_timeout) && o.subscriber_timeout > 0.0, "subscriber_timeout", o.subscriber_timeout,
           "> 0 s");
+  require(o.threads >= 1, "threads", o.threads, "a whole number from 1");
   return problems;
 }
 
@@ -153,6 +154,7 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   reader.read("start_paused", o.start_paused);
   reader.read("wait_for_subscribers", o.wait_for_subscribers);
   reader.read("subscriber_timeout", o.subscriber_timeout);
+  reader.read("threads", o.threads);
   reader.refuseIfAny(validateOptions(o));
   return o;
 }
@@ -227,6 +229,7 @@ void RigSimulator::startSimulation() {
   run.stop_at_scene_end = options_.stop_at_scene_end;
   // Paced, a watcher sees the slider move, and a command sent "now" acts within a frame.
   run.cut_jumps_at_frames = options_.real_time_factor > 0.0;
+  run.threads = options_.threads;
   driver_ = std::make_unique<RunDriver>(scene_, stability_limit_, run);
   driver_->onCommandDue(
       [this](const TimedCommand& command, const std::string& refusal) { publishAppliedCommand(command, refusal); });

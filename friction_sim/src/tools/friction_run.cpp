@@ -8,6 +8,7 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <stdexcept>
 
 #include "friction_sim/instruments/results_io.h"
 #include "friction_sim/run/run_driver.h"
@@ -17,7 +18,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: friction_run SCENE.yaml [--out DIR] [--set key=value...]... [--commands COMMANDS.csv | --protocol "
-    "PROTOCOL.yaml]";
+    "PROTOCOL.yaml] [--threads N]";
 
 /// Exit statuses: a command line that cannot be read, a scene, command table or protocol refused (ConfigError),
 /// and an output directory that cannot be written.
@@ -42,6 +43,8 @@ int help() {
                "  --set key=value...  overrides scene fields (SI units), validated like the file\n"
                "  --commands FILE  drives the stage and F_Z by a command table (rig_report's stage_commands.csv)\n"
                "  --protocol FILE  runs a stage controller's loading protocol from t = 0; its end ends the run\n"
+               "  --threads N  threads for the 2D lattice's force sweeps, used from 10^3 nodes (default 1);\n"
+               "               the same results for any N\n"
                "Exit status: 0 the run ended, 2 a bad command line, 3 a refused scene, command table or protocol,\n"
                "4 DIR cannot be written. On a terminal, a progress line on standard error.\n"
                "Reference: docs/offline_runner.md\n";
@@ -49,9 +52,20 @@ int help() {
 }
 
 struct Arguments {
-  std::string scene_path, out_dir, commands_path, protocol_path;
+  std::string scene_path, out_dir, commands_path, protocol_path, threads = "1";
   std::vector<std::pair<std::string, std::string>> overrides;
 };
+
+/// The thread count --threads gives, if it is a whole number from 1.
+std::optional<int> threadCount(const Arguments& args) {
+  std::size_t end = 0;
+  try {
+    const int threads = std::stoi(args.threads, &end);
+    if (end == args.threads.size() && threads >= 1) return threads;
+  } catch (const std::logic_error&) {
+  }
+  return std::nullopt;
+}
 
 /// Reads the command line into `args`; returns an exit status if the run must not go on.
 std::optional<int> parseArguments(int argc, char** argv, Arguments& args) {
@@ -61,8 +75,10 @@ std::optional<int> parseArguments(int argc, char** argv, Arguments& args) {
   if (argc < 2) return refuseCommandLine("no scene file given");
   if (argv[1][0] == '-') return refuseCommandLine(std::string("the scene file comes first, got '") + argv[1] + "'");
   args.scene_path = argv[1];
-  const std::map<std::string, std::string*> paths = {
-      {"--out", &args.out_dir}, {"--commands", &args.commands_path}, {"--protocol", &args.protocol_path}};
+  const std::map<std::string, std::string*> paths = {{"--out", &args.out_dir},
+                                                     {"--commands", &args.commands_path},
+                                                     {"--protocol", &args.protocol_path},
+                                                     {"--threads", &args.threads}};
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
     if ((paths.count(arg) > 0 || arg == "--set") && i + 1 == argc) return refuseCommandLine(arg + " needs a value");
@@ -85,6 +101,7 @@ std::optional<int> parseArguments(int argc, char** argv, Arguments& args) {
   if (!args.commands_path.empty() && !args.protocol_path.empty()) {
     return refuseCommandLine("--commands and --protocol both drive the stage; give one");
   }
+  if (!threadCount(args)) return refuseCommandLine("--threads " + args.threads + ": allowed: a whole number from 1");
   return std::nullopt;
 }
 
@@ -155,6 +172,7 @@ int run(int argc, char** argv) {
   // A recorded time is its step's rounded to whole nanoseconds: due within half of one. A protocol's
   // times are the ones the rig compared its clock with: due exactly then.
   options.command_early = args.commands_path.empty() ? 0.0 : 0.5e-9;
+  options.threads = *threadCount(args);
   friction::RunDriver driver(scene, stability_limit, options);
   const friction::Simulation& simulation = driver.simulation();
   const std::size_t scheduled_commands = scheduleCommands(args, protocol, driver);

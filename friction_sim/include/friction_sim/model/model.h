@@ -133,6 +133,9 @@ class Model {
   /// The most evaluations evaluateSuccessiveInStrips sweeps the state once for; 1 where sweeping several
   /// together would gain nothing (the chain's state stays in the cache).
   virtual int successiveEvaluations() const { return 1; }
+  /// Threads a force evaluation may use (1: the calling thread alone). A model uses them only where they
+  /// pay, and its results are the same to the last bit for any count.
+  virtual void setThreads(int /*threads*/) {}
   /// The same, with the forces in `out.force`.
   void evaluate(const Vector& u, const Vector& v, double stage_position, ForceEvaluation& out) const {
     evaluateInto(u, v, stage_position, out.force, out);

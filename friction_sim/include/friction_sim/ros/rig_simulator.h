@@ -33,6 +33,8 @@
 //                                   from its start
 //   subscriber_timeout (double, 30) s of wall time to wait for them; then the node logs the topics still
 //                                   short of subscribers and exits with status 5, the run not started
+//   threads (int, 1)                threads for the 2D lattice's force sweeps, used from 10³ nodes; the
+//                                   same results for any count
 //
 // Published topics (relative to the node's namespace; stamps are simulated time):
 //   /clock (rosgraph_msgs/Clock)                   simulated time; at 20 Hz of wall time while paused
@@ -133,6 +135,7 @@ struct SimulatorOptions {
   bool start_paused = false;            ///< wait at t = 0 until `pause` is called with false
   std::string wait_for_subscribers;     ///< "topic[:count] ...": wait at t = 0 until they subscribe
   double subscriber_timeout = 30.0;     ///< s of wall time to wait for them
+  int threads = 1;                      ///< threads for the force sweeps (RunOptions::threads)
 };
 
 using SimulatorConfig = friction_sim::SimulatorConfig;

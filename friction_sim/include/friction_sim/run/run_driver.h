@@ -193,6 +193,8 @@ struct RunOptions {
   /// slider move, and a command sent "now" acts within a frame). Its events may then differ from an uncut
   /// run's by fast-forward's own error: each jump solves the equilibrium afresh.
   bool cut_jumps_at_frames = false;
+  /// Threads for the force evaluations (Simulation::setThreads): the same results for any count.
+  int threads = 1;
 };
 
 /// The stage state now.

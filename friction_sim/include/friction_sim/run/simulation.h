@@ -51,6 +51,9 @@ class Simulation : public Dynamics {
   void advance(double until, double group_before = 0.0);
   /// Advances until the scene's stop condition holds.
   void run();
+  /// Threads the force evaluations may use (Model::setThreads): the same results for any count. With
+  /// threads, the 2D lattice takes its steps one at a time.
+  void setThreads(int threads) { model_->setThreads(threads); }
   /// True while the slider sits in static equilibrium with no node sliding, or creeping quasi-statically
   /// (fast-forward can jump).
   bool quasiStatic() const;

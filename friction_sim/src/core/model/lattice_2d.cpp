@@ -1,10 +1,15 @@
 #include "friction_sim/model/lattice_2d.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
+#include <exception>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace friction {
 
@@ -53,13 +58,11 @@ Lattice2D::Lattice2D(const Scene& scene)
                {0, 1, k_, spacing_, 0.0, 1.0},
                {1, 1, 0.5 * k_, diagonal, c, c},
                {-1, 1, 0.5 * k_, diagonal, -c, c}};
-  horizontal_x_.assign(nx_ + 2, 0.0);
-  horizontal_z_.assign(nx_ + 2, 0.0);
-  for (SweepSpace& space : sweep_space_) {
-    space.column_power.setZero(nx_ + 2);
-    space.upward.resize(nx_ + 2);
-    space.below.resize(nx_ + 2);
+  for (EvaluationSums& sums : sums_) {
+    sums.band_power.assign((nz_ + kPowerBandRows - 1) / kPowerBandRows, 0.0);
+    sums.pusher_force.assign(pushed_rows_.size(), 0.0);
   }
+  setThreads(1);
   // Start the mattress plate where it carries F_Z with the slider undeformed.
   plate_z_ = -normal_force_ / (nx_ * mattress_k_);
 }
@@ -73,6 +76,24 @@ void Lattice2D::forEachBond(const BondFamily& family, Visit&& visit) const {
     const int row = j * nx_;
     for (int i = i_begin; i < i_end; ++i) visit(row + i, row + i + offset);
   }
+}
+
+void Lattice2D::setThreads(int threads) {
+  threads_ = std::max(1, threads);
+  sweep_space_.resize(std::max(kSuccessiveSweeps, threads_));
+  for (SweepSpace& space : sweep_space_) {
+    space.horizontal_x.assign(nx_ + 2, 0.0);
+    space.horizontal_z.assign(nx_ + 2, 0.0);
+    space.column_power.setZero(nx_ + 2);
+    space.upward.resize(nx_ + 2);
+    space.below.resize(nx_ + 2);
+  }
+  handoffs_ = std::vector<BlockHandoff>(threads_ - 1);
+}
+
+int Lattice2D::threadedBlocks() const {
+  const int bands = static_cast<int>(sums_[0].band_power.size());
+  return threads_ > 1 && n_ >= kThreadedNodes ? std::min(threads_, bands) : 1;
 }
 
 double Lattice2D::topSpringForce(const Vector& u, int i) const {
@@ -136,41 +157,84 @@ void bondRow(const NodeArrays& nodes, int a0, int b0, int count, double rest_x, 
 
 }  // namespace
 
+namespace {
+/// Waits for a neighbouring block's flag, or throws once another block has failed: its flags would
+/// never come.
+void awaitFlag(const std::atomic<bool>& flag, const std::atomic<bool>& abandoned) {
+  while (!flag.load(std::memory_order_acquire)) {
+    if (abandoned.load(std::memory_order_relaxed)) {
+      throw std::runtime_error("Lattice2D: the sweep of a neighbouring block of rows failed");
+    }
+    std::this_thread::yield();
+  }
+}
+}  // namespace
+
 /// One force evaluation swept row by row, in strips of whole rows: first every bond of the row
 /// (contiguous runs of nodes, so the loops vectorise), then each node's force gathered once from its eight
 /// bonds, half of them kept from the row below, then the external forces on the row. Buffer index p
 /// holds the bond whose lower-index node is at column p − 1 (p − 2 for the antidiagonal); the padding
 /// entries stay zero. A row at a time, so that other sweeps can follow this one (evaluateSuccessiveInStrips).
+///
+/// A sweep may cover a block of rows while other threads sweep the blocks below and above it. Each node's
+/// force is gathered from its own bonds in the same order whatever the blocks, and the block sweeps the
+/// bonds up from the row below it again for its first row, so the forces are the same to the last bit.
+/// At a seam, the upper block prepares both rows there before the lower block reads them, and it
+/// finishes its first row (changes its velocities) only after the lower block has swept its last.
 class Lattice2D::Sweep {
  public:
-  Sweep(const Lattice2D& lattice, const StripEvaluation& evaluation, int strip_nodes, SweepSpace& space)
+  /// Rows [first_row, end_row), and the hand-offs with the blocks below and above (none at row 0 and at
+  /// the top row).
+  struct Block {
+    int first_row, end_row;
+    BlockHandoff* lower = nullptr;
+    BlockHandoff* upper = nullptr;
+    const std::atomic<bool>* abandoned = nullptr;  ///< set once a block has failed
+  };
+
+  Sweep(const Lattice2D& lattice, const StripEvaluation& evaluation, int strip_nodes, SweepSpace& space,
+        EvaluationSums& sums, Block block)
       : lattice_(lattice),
         evaluation_(evaluation),
         space_(space),
+        sums_(sums),
+        block_(block),
         rows_per_strip_(std::max(1, strip_nodes / lattice.nx_)),
+        prepare_end_(block.upper ? block.end_row - 1 : lattice.nz_),
         bonds_(lattice.geometric_ ? &bondRow<true> : &bondRow<false>),
         nodes_{evaluation.u.data(), evaluation.u.data() + lattice.n_, evaluation.v.data(),
-               evaluation.v.data() + lattice.n_} {
-    evaluation_.force.resize(2 * lattice.n_);
-    evaluation_.out.normal_force.resize(lattice.nx_);
+               evaluation.v.data() + lattice.n_},
+        row_(block.first_row),
+        prepared_rows_(std::max(0, block.first_row - 1)),
+        finished_rows_(block.lower ? block.first_row + 1 : block.first_row),
+        next_pushed_(std::lower_bound(lattice.pushed_rows_.begin(), lattice.pushed_rows_.end(), block.first_row) -
+                     lattice.pushed_rows_.begin()) {
     space_.column_power.setZero();
     space_.below.clear();
   }
 
-  bool done() const { return row_ == lattice_.nz_; }
+  /// Sizes an evaluation's outputs, before any sweep of it writes them.
+  static void sizeOutputs(const Lattice2D& lattice, const StripEvaluation& evaluation) {
+    evaluation.force.resize(2 * lattice.n_);
+    evaluation.out.normal_force.resize(lattice.nx_);
+  }
+
+  bool done() const { return row_ == block_.end_row; }
+  ForceEvaluation& output() const { return evaluation_.out; }
   /// Rows [0, finishedRows()) are finished: their forces final, their finish hooks called, their state
   /// no longer read.
   int finishedRows() const { return finished_rows_; }
   /// Rows [0, preparedRowsForNextRow()) are prepared once the next row is swept: the bonds of row j
-  /// read rows j and j + 1, and rows are prepared a strip at a time.
+  /// read rows j and j + 1, and rows are prepared a strip at a time. Of a block below another, the rows
+  /// from its last on are the upper block's to prepare.
   int preparedRowsForNextRow() const {
     const int rows_needed = std::min(lattice_.nz_, row_ + 2);
     if (prepared_rows_ >= rows_needed) return prepared_rows_;
-    return std::min(lattice_.nz_, std::max(rows_needed, prepared_rows_ + rows_per_strip_));
+    return std::min(prepare_end_, std::max(rows_needed, prepared_rows_ + rows_per_strip_));
   }
 
-  /// The hot kernel, kept whole (68 lines, over the project's 60): it runs for every row of every step,
-  /// and its bonds, gathers and external forces share the row's pointers.
+  /// The hot kernel, kept whole (over the project's 60 lines): it runs for every row of every step, and
+  /// its bonds, gathers and external forces share the row's pointers.
   void sweepRow() {  // NOLINT(readability-function-size): the hot kernel, kept whole (above)
     const Lattice2D& l = lattice_;
     const int nx = l.nx_, nz = l.nz_, n = l.n_, j = row_;
@@ -179,20 +243,30 @@ class Lattice2D::Sweep {
       forBothComponents(prepared_rows_, prepared_end, &StripHooks::prepare);
       prepared_rows_ = prepared_end;
     }
+    if (block_.lower && j == block_.first_row) {
+      // The bonds up from the row below, which the lower block sweeps too; their power is counted there.
+      upwardBonds(j - 1, space_.below);
+      space_.column_power.setZero();
+      block_.lower->upper_started.store(true, std::memory_order_release);
+    }
+    if (block_.upper && j + 2 > prepare_end_) awaitFlag(block_.upper->upper_started, *block_.abandoned);
     double* fx = evaluation_.force.data();
     double* fz = evaluation_.force.data() + n;
     const double* ux = evaluation_.u.data();
     const double* uz = evaluation_.u.data() + n;
     RowBonds& upward = space_.upward;
     const RowBonds& below = space_.below;
-    const int row = j * nx, next = row + nx;
-    run(l.families_[0], row, row + 1, nx - 1, l.horizontal_x_.data() + 1, l.horizontal_z_.data() + 1);
+    const int row = j * nx;
+    run(l.families_[0], row, row + 1, nx - 1, space_.horizontal_x.data() + 1, space_.horizontal_z.data() + 1);
     if (j + 1 < nz) {
-      run(l.families_[1], row, next, nx, upward.vertical_x.data(), upward.vertical_z.data());
-      run(l.families_[2], row, next + 1, nx - 1, upward.diagonal_x.data() + 1, upward.diagonal_z.data() + 1);
-      run(l.families_[3], row + 1, next, nx - 1, upward.antidiagonal_x.data() + 2, upward.antidiagonal_z.data() + 2);
+      upwardBonds(j, upward);
     } else {
       upward.clear();
+    }
+    if (block_.upper && j + 1 == block_.end_row) block_.upper->lower_swept.store(true, std::memory_order_release);
+    if ((j + 1) % kPowerBandRows == 0 || j + 1 == nz) {
+      sums_.band_power[j / kPowerBandRows] = space_.column_power.sum();
+      space_.column_power.setZero();
     }
     auto gather = [nx](const double* __restrict h, const double* __restrict vu, const double* __restrict du,
                        const double* __restrict au, const double* __restrict vb, const double* __restrict db,
@@ -201,9 +275,9 @@ class Lattice2D::Sweep {
         f[i] = ((h[i + 1] - h[i]) + (vu[i] - vb[i])) + ((du[i + 1] - db[i]) + (au[i + 1] - ab[i + 2]));
       }
     };
-    gather(l.horizontal_x_.data(), upward.vertical_x.data(), upward.diagonal_x.data(), upward.antidiagonal_x.data(),
+    gather(space_.horizontal_x.data(), upward.vertical_x.data(), upward.diagonal_x.data(), upward.antidiagonal_x.data(),
            below.vertical_x.data(), below.diagonal_x.data(), below.antidiagonal_x.data(), fx + row);
-    gather(l.horizontal_z_.data(), upward.vertical_z.data(), upward.diagonal_z.data(), upward.antidiagonal_z.data(),
+    gather(space_.horizontal_z.data(), upward.vertical_z.data(), upward.diagonal_z.data(), upward.antidiagonal_z.data(),
            below.vertical_z.data(), below.diagonal_z.data(), below.antidiagonal_z.data(), fz + row);
     std::swap(space_.upward, space_.below);
     if (j == 0) {
@@ -214,17 +288,19 @@ class Lattice2D::Sweep {
       }
     }
     if (j == nz - 1) {
+      double top_normal = 0.0;
       for (int i = 0; i < nx; ++i) {
         const int top = l.nodeIndex(i, j);
         if (l.mattress_) {
           const double spring = l.topSpringForce(evaluation_.u, i);
           fz[top] += spring;
           fx[top] += l.mattress_kx_per_node_ * (l.top_anchor_x_[i] - ux[top]);
-          normal_sum_top_ -= spring;
+          top_normal -= spring;
         } else {
           fz[top] -= l.normal_force_ / nx;
         }
       }
+      sums_.top_normal = top_normal;
     }
     for (; l.pusher_connected_ && next_pushed_ < l.pushed_rows_.size() && l.pushed_rows_[next_pushed_] == j;
          ++next_pushed_) {
@@ -232,20 +308,30 @@ class Lattice2D::Sweep {
       const double pusher_force =
           l.pusher_k_per_row_ * (evaluation_.stage_position + l.pusher_offset_[next_pushed_] - ux[node]);
       fx[node] += pusher_force;
-      shear_ += pusher_force;
+      sums_.pusher_force[next_pushed_] = pusher_force;
     }
-    if (j + 1 - finished_rows_ >= rows_per_strip_ || j == nz - 1) {
-      forBothComponents(finished_rows_, j + 1, &StripHooks::finish);
+    if (j + 1 - finished_rows_ >= rows_per_strip_ || j + 1 == block_.end_row) {
+      if (finished_rows_ < j + 1) forBothComponents(finished_rows_, j + 1, &StripHooks::finish);
       finished_rows_ = j + 1;
     }
     ++row_;
+    if (done() && block_.lower) {
+      awaitFlag(block_.lower->lower_swept, *block_.abandoned);
+      forBothComponents(block_.first_row, block_.first_row + 1, &StripHooks::finish);
+    }
   }
 
-  /// The evaluation's sums, once every row is swept.
-  void complete() {
-    evaluation_.out.viscous_power = space_.column_power.sum();
-    evaluation_.out.normal_load = lattice_.mattress_ ? normal_sum_top_ : lattice_.normal_force_;
-    evaluation_.out.shear_force = shear_;
+  /// The evaluation's sums, in the order of the rows, once every row of every block is swept.
+  static void complete(const Lattice2D& lattice, const EvaluationSums& sums, ForceEvaluation& out) {
+    double power = 0.0;
+    for (double band : sums.band_power) power += band;
+    double shear = 0.0;
+    if (lattice.pusher_connected_) {
+      for (double force : sums.pusher_force) shear += force;
+    }
+    out.viscous_power = power;
+    out.normal_load = lattice.mattress_ ? sums.top_normal : lattice.normal_force_;
+    out.shear_force = shear;
   }
 
  private:
@@ -256,6 +342,15 @@ class Lattice2D::Sweep {
     (evaluation_.hooks.*hook)(n + first_row * nx, n + end_row * nx);
   }
 
+  /// The bonds from row j up to row j + 1.
+  void upwardBonds(int j, RowBonds& into) {
+    const Lattice2D& l = lattice_;
+    const int row = j * l.nx_, next = row + l.nx_;
+    run(l.families_[1], row, next, l.nx_, into.vertical_x.data(), into.vertical_z.data());
+    run(l.families_[2], row, next + 1, l.nx_ - 1, into.diagonal_x.data() + 1, into.diagonal_z.data() + 1);
+    run(l.families_[3], row + 1, next, l.nx_ - 1, into.antidiagonal_x.data() + 2, into.antidiagonal_z.data() + 2);
+  }
+
   void run(const BondFamily& family, int a0, int b0, int count, double* out_x, double* out_z) {
     bonds_(nodes_, a0, b0, count, family.ex * family.rest_length, family.ez * family.rest_length, family.rest_length,
            family.stiffness, lattice_.eta_, out_x, out_z, space_.column_power.data());
@@ -264,14 +359,16 @@ class Lattice2D::Sweep {
   const Lattice2D& lattice_;
   const StripEvaluation evaluation_;  ///< a copy (of references): the caller's may be a temporary
   SweepSpace& space_;
+  EvaluationSums& sums_;
+  const Block block_;
   const int rows_per_strip_;
+  /// Rows [0, prepare_end_) are this sweep's or the blocks' below it to prepare.
+  const int prepare_end_;
   decltype(&bondRow<true>) bonds_;
   /// Built once: rebuilt for each run of bonds, it made a 32 × 32 lattice's step about 10 % slower.
   const NodeArrays nodes_;
-  int row_ = 0, prepared_rows_ = 0, finished_rows_ = 0;
-  double normal_sum_top_ = 0.0;  ///< N, the mattress's springs on the top row
-  double shear_ = 0.0;           ///< N, the pusher's force
-  std::size_t next_pushed_ = 0;  ///< the next pushed row, in pushed_rows_
+  int row_, prepared_rows_, finished_rows_;
+  std::size_t next_pushed_;  ///< the next pushed row, in pushed_rows_
 };
 
 void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_position, Vector& force,
@@ -282,9 +379,51 @@ void Lattice2D::evaluateInto(const Vector& u, const Vector& v, double stage_posi
 
 void Lattice2D::evaluateInStrips(const Vector& u, const Vector& v, double stage_position, Vector& force,
                                  ForceEvaluation& out, StripHooks& hooks, int strip_nodes) const {
-  Sweep sweep(*this, {u, v, stage_position, force, out, hooks}, strip_nodes, sweep_space_[0]);
-  while (!sweep.done()) sweep.sweepRow();
-  sweep.complete();
+  const StripEvaluation evaluation{u, v, stage_position, force, out, hooks};
+  Sweep::sizeOutputs(*this, evaluation);
+  const int blocks = threadedBlocks();
+  if (blocks == 1) {
+    Sweep sweep(*this, evaluation, strip_nodes, sweep_space_[0], sums_[0], {0, nz_});
+    while (!sweep.done()) sweep.sweepRow();
+  } else {
+    sweepInBlocks(evaluation, strip_nodes, blocks);
+  }
+  Sweep::complete(*this, sums_[0], out);
+}
+
+void Lattice2D::sweepInBlocks(const StripEvaluation& evaluation, int strip_nodes, int blocks) const {
+  for (int k = 0; k + 1 < blocks; ++k) {
+    handoffs_[k].upper_started.store(false, std::memory_order_relaxed);
+    handoffs_[k].lower_swept.store(false, std::memory_order_relaxed);
+  }
+  const int bands = static_cast<int>(sums_[0].band_power.size());
+  std::atomic<bool> abandoned{false};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+#pragma omp parallel num_threads(blocks)
+  {
+    // As many blocks as threads came, each of whole bands of rows, as even as the bands allow; the first
+    // block, with the interface's friction, rounded down.
+    const int count = omp_get_num_threads(), k = omp_get_thread_num();
+    auto first_row = [&](int block) {
+      if (block == count) return nz_;
+      int band = 0;
+      for (int b = 1; b <= block; ++b)
+        band = std::max(band + 1, std::min(nz_ * b / count / kPowerBandRows, bands - count + b));
+      return band * kPowerBandRows;
+    };
+    const Sweep::Block block{first_row(k), first_row(k + 1), k > 0 ? &handoffs_[k - 1] : nullptr,
+                             k + 1 < count ? &handoffs_[k] : nullptr, &abandoned};
+    try {
+      Sweep sweep(*this, evaluation, strip_nodes, sweep_space_[k], sums_[0], block);
+      while (!sweep.done()) sweep.sweepRow();
+    } catch (...) {
+      abandoned.store(true);
+      const std::lock_guard<std::mutex> lock(error_mutex);
+      if (!error) error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
 }
 
 int Lattice2D::evaluateSuccessiveInStrips(int strip_nodes,
@@ -292,7 +431,8 @@ int Lattice2D::evaluateSuccessiveInStrips(int strip_nodes,
   std::array<std::optional<Sweep>, kSuccessiveSweeps> sweeps;
   const std::optional<StripEvaluation> first = next(0);
   if (!first) return 0;
-  sweeps[0].emplace(*this, *first, strip_nodes, sweep_space_[0]);
+  Sweep::sizeOutputs(*this, *first);
+  sweeps[0].emplace(*this, *first, strip_nodes, sweep_space_[0], sums_[0], Sweep::Block{0, nz_});
   int started = 1;
   bool asking = true;
   for (;;) {
@@ -306,7 +446,9 @@ int Lattice2D::evaluateSuccessiveInStrips(int strip_nodes,
           throw std::logic_error("Lattice2D::evaluateSuccessiveInStrips: asked for more than " +
                                  std::to_string(kSuccessiveSweeps) + " evaluations");
         }
-        sweeps[started].emplace(*this, *evaluation, strip_nodes, sweep_space_[started]);
+        Sweep::sizeOutputs(*this, *evaluation);
+        sweeps[started].emplace(*this, *evaluation, strip_nodes, sweep_space_[started], sums_[started],
+                                Sweep::Block{0, nz_});
         ++started;
       }
       continue;
@@ -319,7 +461,7 @@ int Lattice2D::evaluateSuccessiveInStrips(int strip_nodes,
     while (k > 0 && sweeps[k]->preparedRowsForNextRow() > sweeps[k - 1]->finishedRows()) --k;
     sweeps[k]->sweepRow();
   }
-  for (int k = 0; k < started; ++k) sweeps[k]->complete();
+  for (int k = 0; k < started; ++k) Sweep::complete(*this, sums_[k], sweeps[k]->output());
   return started;
 }
 

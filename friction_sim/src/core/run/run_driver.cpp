@@ -30,7 +30,9 @@ void EventStream::after(const Simulation& simulation, bool /*jumped*/) {
 }
 
 RunDriver::RunDriver(const Scene& scene, double stability_limit, RunOptions options)
-    : simulation_(scene, stability_limit), options_(options), schedule_(options.command_early) {}
+    : simulation_(scene, stability_limit), options_(options), schedule_(options.command_early) {
+  simulation_.setThreads(options.threads);
+}
 
 std::string RunDriver::setRunEnd(const StopSpec& stop) {
   std::string refusal = simulation_.setStopCondition(stop);
