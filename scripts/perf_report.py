@@ -39,12 +39,15 @@ LATTICE_SIZES = ["33/31", "57/31", "113/61", "225/121", "449/241", "1001/61", "1
 REMAINDER_SIZE = "32/32"
 # The lattices a naive step of the same bulk (benchmarks/naive_lattice.h) is measured on, for scale.
 NAIVE_SIZES = ["57/31", "225/121", "1001/1001"]
+# The lattices stepped on two threads (latticeStepOnThreads), against latticeStep on one.
+THREADED_SIZES = ["57/31", "225/121", "449/241", "1001/1001"]
 # The cases the report reads by name: a bench_kernels built before one of them was added is refused at
 # the start rather than at the end of the run.
 REQUIRED_CASES = (["latticeStep/geometric/" + size for size in LATTICE_SIZES + [REMAINDER_SIZE]] +
                   ["latticeStep/linearised/57/31", "chainStep/2", "chainStep/57",
                    "stateStream/1767", "leapfrogStream/1767", "bondDividerFloor"] +
-                  [case + size for size in NAIVE_SIZES for case in ("naiveLatticeStep/", "latticeStepOneAtATime/")])
+                  [case + size for size in NAIVE_SIZES for case in ("naiveLatticeStep/", "latticeStepOneAtATime/")] +
+                  ["latticeStepOnThreads/%s/2" % size for size in THREADED_SIZES])
 
 
 def size_label(size):
@@ -284,7 +287,7 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
              "lattice, and 45 on slower hosts of this kind; finished runs and the kernels' benchmark results in "
              "`.build/perf/` are reused, delete it to start afresh).", "",
              "## The machine", "",
-             "- %s, %s; %d cores used: 1 (every run is single-threaded)" % (platform.processor() or platform.machine(),
+             "- %s, %s; %d cores; every run on one thread but the threads table's" % (platform.processor() or platform.machine(),
                                                                            cpu_model(), os.cpu_count()),
              "- %s; g++ -O3 -march=native (option FRICTION_SIM_NATIVE)" % platform.platform(),
              "- measured on %s" % time.strftime("%Y-%m-%d"), ""]
@@ -305,7 +308,7 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
     lines += ["", "The host is shared and its speed drifts from minute to minute, so the five passes are spread over "
               "the minutes rather than run in a row. `stateStream/1767`, a plain stream in cache whose cost no change "
               "to the project's code affects, ranged over %.2f – %.2f ns in them: compare a case with it rather than "
-              "across regenerations." % (min(stream), max(stream)), ""] + kernels_discussion(median)
+              "across regenerations." % (min(stream), max(stream)), ""] + kernels_discussion(median) + threads_section(median)
     lines += ["", "## Whole runs: wall time and peak memory", "",
               "Each in a fresh process; wall time includes building the model, the stability limit and the loading "
               "solve.", "", "| run | wall (s) | peak memory (MB) |", "|---|---|---|"]
@@ -504,6 +507,19 @@ TRIED_AND_DROPPED = [
      "gathering and closing kick of row j − 1)", "57 × 31, 2026-11-25", "6.12", "6.60 (same work, separate loops)",
      "7 %: hiding the rest of the step under the divider would not reach 5 ns on that host"),
 ]
+
+
+def threads_section(median):
+    """The lattice's step on two threads against one, from the kernels' medians, as Markdown lines."""
+    lines = ["", "### Threads", "",
+             "Each step's sweep split into blocks of rows, one per thread (`--threads 2`); one step per sweep then. "
+             "The results are the same to the last bit for any thread count (tests `LatticeThreads`, "
+             "`SimulationThreads`).", "",
+             "| lattice | one thread, steps in groups (ns per node-step) | two threads | speed-up |", "|---|---|---|---|"]
+    for size in THREADED_SIZES:
+        one, two = median["latticeStep/geometric/" + size], median["latticeStepOnThreads/%s/2" % size]
+        lines.append("| %s | %.2f | %.2f | %.2f× |" % (size_label(size), one, two, one / two))
+    return lines
 
 
 def kernels_discussion(median):

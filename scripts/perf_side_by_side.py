@@ -1,0 +1,214 @@
+#!/usr/bin/python3
+"""Measures this build against an earlier one, interleaved in one sitting on one host, and writes
+docs/benchmarks/side_by_side.md: every case as a ratio, the cost of whole runs against the number of
+nodes (its exponent), the share of dynamic stepping and of start-up in each, and the threads' gain.
+
+    scripts/perf_side_by_side.py BASE_REV [--rounds N] [--rewrite]
+
+Builds BASE_REV's friction_run in a worktree (.build/baseline/<rev>), then runs each case with both
+runners, round after round, the two in a random order within each case, so that the host's drift falls on
+both alike. Runs are fresh processes; a case's time is the process's wall time. The measurements are
+kept in .build/baseline/side_by_side.json: --rewrite writes the report from them again without running.
+About 4 minutes a round on a 2-core AMD EPYC of family 23 against a build of 2026-11-25, most of it the
+225 × 121 and 449 × 241 runs.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import random
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from perf_report import SCENE, cpu_model  # noqa: E402
+from sweep import ROOT, RUNNER  # noqa: E402
+
+REPORT = os.path.join(ROOT, "docs/benchmarks/side_by_side.md")
+MEASURED = os.path.join(ROOT, ".build/baseline/side_by_side.json")
+# The lattices of the report (nodes_x, nodes_z, dt): pmma_2d's slider, dt scaled with the spacing.
+SIZES = [(57, 31, "2e-7"), (113, 61, "1e-7"), (225, 121, "5e-8"), (449, 241, "2.5e-8")]
+# A size's cost per node-step in a run: the difference of two full-dynamics runs of STEPPED and
+# 2·STEPPED steps, over STEPPED steps, so that everything but the steps cancels.
+STEPPED = 2000
+# The sizes whose whole run to the first global event is measured: 449 × 241's takes minutes a run.
+WHOLE_RUN_SIZES = 3
+
+
+def build_baseline(rev):
+    """The friction_run of `rev`, built in its own worktree and catkin workspace."""
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", rev], check=True, capture_output=True,
+                            text=True).stdout.strip()
+    tree = os.path.join(ROOT, ".build/baseline", commit)
+    if not os.path.isdir(tree):
+        subprocess.run(["git", "-C", ROOT, "worktree", "add", "--detach", tree, commit], check=True)
+    runner = os.path.join(tree, ".build/devel/lib/friction_sim/friction_run")
+    if not os.path.exists(runner):
+        env = dict(os.environ, PATH="/usr/bin:" + os.environ["PATH"])
+        subprocess.run([os.path.join(tree, "scripts/build.sh"), "-j2", "friction_run"], check=True, env=env,
+                       stdout=subprocess.DEVNULL)
+    return commit, runner
+
+
+def stepped_name(steps, nx, nz, threads=1):
+    return "%d steps %d × %d%s" % (steps, nx, nz, ", %d threads" % threads if threads > 1 else "")
+
+
+def cases():
+    """(name, settings, threads): start-up, stepping and whole runs at each size, and threads."""
+    listed = []
+    for index, (nx, nz, dt) in enumerate(SIZES):
+        size = {"lattice.nodes_x": nx, "lattice.nodes_z": nz, "integrator.time_step": dt}
+        label = "%d × %d" % (nx, nz)
+        listed.append(("start-up " + label, dict(size, **{"stop.time": "1e-9"}), 1))
+        for steps in (STEPPED, 2 * STEPPED):
+            full = dict(size, **{"integrator.fast_forward": "false", "stop.time": "%g" % ((steps - 0.5) * float(dt))})
+            listed.append((stepped_name(steps, nx, nz), full, 1))
+            if index == len(SIZES) - 1:
+                listed.append((stepped_name(steps, nx, nz, 2), full, 2))
+        if index < WHOLE_RUN_SIZES:
+            listed.append(("first global event " + label, size, 1))
+    return listed
+
+
+def per_node_step(medians, build, nx, nz, threads=1):
+    """s per node-step of a build's full-dynamics steps, from the two stepped runs' medians."""
+    longer = medians[stepped_name(2 * STEPPED, nx, nz, threads)][build]
+    shorter = medians[stepped_name(STEPPED, nx, nz, threads)][build]
+    return (longer - shorter) / (STEPPED * nx * nz)
+
+
+def timed_run(runner, settings, threads, out):
+    """Wall time (s) of one run in a fresh process, its step count and its events' onsets and kinds."""
+    args = [runner, SCENE, "--out", out]
+    for key, value in settings.items():
+        args += ["--set", "%s=%s" % (key, value)]
+    if threads > 1:
+        args += ["--threads", str(threads)]
+    start = time.monotonic()
+    subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wall = time.monotonic() - start
+    with open(os.path.join(out, "summary.txt")) as handle:
+        steps = int(next(word for line in handle if " steps of " in line
+                         for word in [line.split(" in ")[1].split()[0]]))
+    with open(os.path.join(out, "events.csv")) as handle:
+        events = [(row["onset_time_s"], row["global"]) for row in csv.DictReader(handle)]
+    return wall, steps, events
+
+
+def measure(builds, rounds):
+    """{case name: {build: [wall per round]}}, steps and events per case and build."""
+    walls, steps, events = {}, {}, {}
+    work = tempfile.mkdtemp(prefix="side_by_side_")
+    for round_index in range(rounds):
+        for name, settings, threads in cases():
+            order = [b for b in builds if threads == 1 or b == "this build"]
+            random.shuffle(order)
+            for build in order:
+                out = os.path.join(work, build.replace(" ", "_"))
+                wall, count, onsets = timed_run(builds[build], settings, threads, out)
+                walls.setdefault(name, {}).setdefault(build, []).append(wall)
+                steps[(name, build)] = count
+                events[(name, build)] = onsets
+                print("round %d  %-40s %-12s %8.3f s" % (round_index + 1, name, build, wall), flush=True)
+    return walls, steps, events
+
+
+def spread(values):
+    return "%.3f (%.3f – %.3f)" % (statistics.median(values), min(values), max(values))
+
+
+def exponent(points):
+    """The slope of log(wall) against log(nodes), least squares."""
+    xs = [math.log(n) for n, _ in points]
+    ys = [math.log(w) for _, w in points]
+    mx, my = statistics.mean(xs), statistics.mean(ys)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+
+
+def write(base, walls, steps, events, rounds):
+    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], check=True, capture_output=True,
+                          text=True).stdout.strip()
+    builds = ["base", "this build"]
+    lines = ["# This build against %s, side by side" % base, "",
+             "Regenerated by `scripts/perf_side_by_side.py %s --rounds %d` at %s on %s, %s (%d cores), "
+             "%s. Each case ran once per round with each build, the two in a random order; wall times of "
+             "fresh processes, medians of %d rounds (fastest – slowest). Speed-up: the base's median over "
+             "this build's." % (base, rounds, head, cpu_model(), os.uname().machine, os.cpu_count(),
+                                time.strftime("%Y-%m-%d"), rounds), "",
+             "| case | %s (s) | this build (s) | speed-up | same steps and events |" % base, "|---|---|---|---|---|"]
+    medians = {name: {b: statistics.median(v) for b, v in per_build.items()} for name, per_build in walls.items()}
+    for name, _, threads in cases():
+        if threads > 1:
+            continue
+        same = (steps[(name, "base")] == steps[(name, "this build")]
+                and events[(name, "base")] == events[(name, "this build")])
+        lines.append("| %s | %s | %s | %.2f× | %s |" % (name, spread(walls[name]["base"]),
+                                                         spread(walls[name]["this build"]),
+                                                         medians[name]["base"] / medians[name]["this build"],
+                                                         "yes" if same else "no"))
+    lines += ["", "## Where a whole run's time goes", "",
+              "Per node-step: the difference of the %d- and %d-step full-dynamics runs over %d steps × nodes. "
+              "Dynamic share: the whole run's steps × nodes at that cost, over its wall time. Start-up share: the "
+              "start-up's wall time (a run that stops at once: building, checking and loading the slider, "
+              "fast-forward's set-up) over the whole run's." % (STEPPED, 2 * STEPPED, STEPPED), "",
+              "| lattice | build | whole run (s) | steps | ns per node-step | dynamic share | start-up share |",
+              "|---|---|---|---|---|---|---|"]
+    points = {b: [] for b in builds}
+    for nx, nz, _ in SIZES[:WHOLE_RUN_SIZES]:
+        label, nodes = "%d × %d" % (nx, nz), nx * nz
+        for build in builds:
+            whole = medians["first global event " + label][build]
+            startup = medians["start-up " + label][build]
+            cost = per_node_step(medians, build, nx, nz)
+            run_steps = steps[("first global event " + label, build)]
+            points[build].append((nodes, whole))
+            lines.append("| %s | %s | %.2f | %d | %.1f | %.0f %% | %.0f %% |" % (
+                label, base if build == "base" else build, whole, run_steps, cost * 1e9,
+                100 * run_steps * nodes * cost / whole, 100 * startup / whole))
+    lines += ["", "Whole runs grow as N^%.2f with this build and N^%.2f with %s (least squares over %s nodes)." % (
+        exponent(points["this build"]), exponent(points["base"]), base,
+        ", ".join(str(nx * nz) for nx, nz, _ in SIZES[:WHOLE_RUN_SIZES]))]
+    nx, nz, _ = SIZES[-1]
+    one, two = (per_node_step(medians, "this build", nx, nz, threads) for threads in (1, 2))
+    same = all((steps[(stepped_name(n, nx, nz), "this build")], events[(stepped_name(n, nx, nz), "this build")]) ==
+               (steps[(stepped_name(n, nx, nz, 2), "this build")], events[(stepped_name(n, nx, nz, 2), "this build")])
+               for n in (STEPPED, 2 * STEPPED))
+    lines += ["", "## Threads", "",
+              "| %d × %d, full dynamics | 1 thread (ns per node-step) | 2 threads | speed-up | same steps and events |"
+              % (nx, nz), "|---|---|---|---|---|",
+              "| this build | %.1f | %.1f | %.2f× | %s |" % (one * 1e9, two * 1e9, one / two, "yes" if same else "no")]
+    os.makedirs(os.path.dirname(REPORT), exist_ok=True)
+    with open(REPORT, "w") as handle:
+        handle.write("\n".join(lines) + "\n")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("base", help="the earlier build's git revision")
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--rewrite", action="store_true", help="write the report from the kept measurements")
+    args = parser.parse_args()
+    if args.rewrite:
+        with open(MEASURED) as handle:
+            kept = json.load(handle)
+        steps = {tuple(key.split("|")): value for key, value in kept["steps"].items()}
+        events = {tuple(key.split("|")): [tuple(e) for e in value] for key, value in kept["events"].items()}
+        write(kept["base"], kept["walls"], steps, events, kept["rounds"])
+        return
+    commit, base_runner = build_baseline(args.base)
+    walls, steps, events = measure({"base": base_runner, "this build": RUNNER}, args.rounds)
+    with open(MEASURED, "w") as handle:
+        json.dump({"base": commit, "rounds": args.rounds, "walls": walls,
+                   "steps": {"|".join(key): value for key, value in steps.items()},
+                   "events": {"|".join(key): value for key, value in events.items()}}, handle)
+    write(commit, walls, steps, events, args.rounds)
+    print("written", REPORT)
+
+
+if __name__ == "__main__":
+    main()
