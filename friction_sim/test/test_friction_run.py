@@ -12,7 +12,8 @@ import tempfile
 import unittest
 
 import rosunit
-from catkin.find_in_workspaces import find_in_workspaces
+
+import built
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENE = os.path.join(ROOT, "friction_sim/scenes/single_block.yaml")
@@ -20,9 +21,7 @@ SCENE = os.path.join(ROOT, "friction_sim/scenes/single_block.yaml")
 
 class FrictionRunCommandLineTest(unittest.TestCase):
     def setUp(self):
-        runners = find_in_workspaces(["libexec"], project="friction_sim", path="friction_run", first_match_only=True)
-        self.assertTrue(runners, "friction_run is not built")
-        self.runner = runners[0]
+        self.runner = built.friction_run()
         self.work = tempfile.mkdtemp(prefix="friction_run_test_")
         self.addCleanup(shutil.rmtree, self.work)
         self.out = os.path.join(self.work, "out")

@@ -12,7 +12,8 @@ import tempfile
 import unittest
 
 import rosunit
-from catkin.find_in_workspaces import find_in_workspaces
+
+import built
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENES = ["pmma_2d", "pmma_2d_rate_state", "pmma_1d_side", "pmma_1d_top", "single_block", "rate_state"]
@@ -34,8 +35,7 @@ def four_gigabytes():
 
 class FuzzTest(unittest.TestCase):
     def test_every_fuzzed_scene_runs_or_is_refused_naming_its_fields(self):
-        runner = find_in_workspaces(["libexec"], project="friction_sim", path="friction_run", first_match_only=True)
-        self.assertTrue(runner, "friction_run is not built")
+        runner = built.friction_run()
         rng = random.Random(int(os.environ.get("FUZZ_SEED", "1")))
         out = tempfile.mkdtemp(prefix="fuzz_")
         outcomes = {}
@@ -44,7 +44,7 @@ class FuzzTest(unittest.TestCase):
             mutations = ["%s=%s" % (rng.choice(FIELDS), rng.choice(VALUES)) for _ in range(rng.randint(1, 2))]
             case = "%s %s" % (os.path.basename(scene), " ".join(mutations))
             try:
-                done = subprocess.run([runner[0], scene, "--out", out, "--set"] + mutations + ["stop.time=2e-4"],
+                done = subprocess.run([runner, scene, "--out", out, "--set"] + mutations + ["stop.time=2e-4"],
                                       capture_output=True, text=True, timeout=20, preexec_fn=four_gigabytes)
             except subprocess.TimeoutExpired:
                 self.fail("hung: " + case)

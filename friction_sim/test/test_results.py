@@ -14,17 +14,17 @@ import numpy as np
 import rosbag
 import rospy
 import rosunit
-from catkin.find_in_workspaces import find_in_workspaces
 from friction_msgs.msg import InterfaceState, SlipEvent, StrainGaugeProfile
 from friction_sim import results
 from geometry_msgs.msg import WrenchStamped
+
+import built
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def friction_run(scene, out, *assignments):
-    runner = find_in_workspaces(["libexec"], project="friction_sim", path="friction_run", first_match_only=True)[0]
-    command = [runner, os.path.join(ROOT, "friction_sim", scene), "--out", out]
+    command = [built.friction_run(), os.path.join(ROOT, "friction_sim", scene), "--out", out]
     if assignments:
         command += ["--set"] + list(assignments)
     subprocess.run(command, check=True, capture_output=True, timeout=300)

@@ -15,11 +15,12 @@ from unittest import mock
 
 import rosunit
 import yaml
-from catkin.find_in_workspaces import find_in_workspaces
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import sweep  # noqa: E402
+
+import built  # noqa: E402
 
 with open(os.path.join(ROOT, "friction_sim/scenes/single_block.yaml")) as scene:
     STATIC_COEFFICIENT = yaml.safe_load(scene)["friction"]["static_coefficient"]
@@ -27,9 +28,7 @@ with open(os.path.join(ROOT, "friction_sim/scenes/single_block.yaml")) as scene:
 
 class SweepTest(unittest.TestCase):
     def setUp(self):
-        runners = find_in_workspaces(["libexec"], project="friction_sim", path="friction_run", first_match_only=True)
-        self.assertTrue(runners, "friction_run is not built")
-        runner = mock.patch.object(sweep, "RUNNER", runners[0])
+        runner = mock.patch.object(sweep, "RUNNER", built.friction_run())
         runner.start()
         self.addCleanup(runner.stop)
         self.work = tempfile.mkdtemp(prefix="sweep_test_")
