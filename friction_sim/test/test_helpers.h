@@ -3,8 +3,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <mutex>
+#include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "friction_sim/model/model.h"
@@ -110,7 +114,24 @@ class RecordingHooks : public StripHooks {  // each dof's records are its own: t
     normal_force_ = &normal_force;
     first_interface_dof_ = first_interface_dof;
   }
+  /// Also stalls 5 ms before preparing a strip that starts at the row before a seam between two blocks of
+  /// a threaded sweep (`seam_rows`: each upper block's first row; the upper block prepares from there), and
+  /// after finishing a strip that ends there (the lower block, before its last row): a sweep that read the
+  /// seam's rows before they were prepared, or changed the upper block's first row before the lower block
+  /// had swept its last, would then give other forces. The lattice is `nodes_x` wide, of `nodes` nodes.
+  void stallAtSeams(const std::vector<int>& seam_rows, int nodes_x, int nodes) {
+    seam_rows_ = seam_rows;
+    nodes_x_ = nodes_x;
+    nodes_ = nodes;
+  }
+  /// The threads that called the hooks.
+  std::size_t threads() const {
+    const std::lock_guard<std::mutex> lock(threads_mutex_);
+    return threads_.size();
+  }
   void prepare(int first, int end) override {
+    noteThread();
+    if (atSeam(first)) std::this_thread::sleep_for(std::chrono::milliseconds(5));
     for (int i = first; i < end; ++i) {
       ++prepared_[i];
       if (!std::isnan(force_[i])) untouched_force_at_prepare_ = false;
@@ -118,6 +139,13 @@ class RecordingHooks : public StripHooks {  // each dof's records are its own: t
     }
   }
   void finish(int first, int end) override {
+    noteThread();
+    struct StallAfter {
+      bool stall;
+      ~StallAfter() {
+        if (stall) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    } stall_after{atSeam(end)};
     for (int i = first; i < end; ++i) {
       ++finished_[i];
       forces_at_finish_[i] = force_[i];
@@ -147,6 +175,20 @@ class RecordingHooks : public StripHooks {  // each dof's records are its own: t
   std::vector<int> prepared_, finished_;
   Vector forces_at_finish_, normal_forces_at_finish_;
   std::atomic<bool> untouched_force_at_prepare_{true};  ///< threads may prepare strips at once
+  std::vector<int> seam_rows_;
+  int nodes_x_ = 1, nodes_ = 0;
+  mutable std::mutex threads_mutex_;
+  std::set<std::thread::id> threads_;
+
+  /// Whether `dof` is the x component of the first node of the row before a seam.
+  bool atSeam(int dof) const {
+    return dof < nodes_ && dof % nodes_x_ == 0 &&
+           std::find(seam_rows_.begin(), seam_rows_.end(), dof / nodes_x_ + 1) != seam_rows_.end();
+  }
+  void noteThread() {
+    const std::lock_guard<std::mutex> lock(threads_mutex_);
+    threads_.insert(std::this_thread::get_id());
+  }
 };
 
 }  // namespace friction::testing

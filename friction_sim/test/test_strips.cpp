@@ -20,10 +20,11 @@ namespace {
 /// normal forces must be the same bit for bit: a dof read before it was prepared, or a velocity read
 /// after its dof was finished, would change them. The damping power is a sum taken strip by strip, so
 /// it may differ from the one sweep's in the last digits (`power_tolerance`, relative). The one sweep is
-/// `one_sweep`'s where given (the same model, unthreaded).
+/// `one_sweep`'s where given (the same model, unthreaded); a threaded sweep's `seam_rows` (each upper
+/// block's first row) are where the hooks stall, to give the threads their worst order.
 void expectStripsGiveOneSweep(const Model& model, const Vector& u, double stage_position,
                               const std::vector<int>& strip_sizes, double power_tolerance,
-                              const Model* one_sweep = nullptr) {
+                              const Model* one_sweep = nullptr, const std::vector<int>& seam_rows = {}) {
   const int n = model.dofCount();
   Vector v(n), shift(n), kick(n);
   for (int i = 0; i < n; ++i) {
@@ -43,7 +44,12 @@ void expectStripsGiveOneSweep(const Model& model, const Vector& u, double stage_
     testing::RecordingHooks hooks(u_strips, shift, strips.force);
     hooks.kickAtFinish(v_strips, kick);
     hooks.recordNormalForces(strips.normal_force, first_interface_dof);
+    const auto shape = model.gridShape();
+    hooks.stallAtSeams(seam_rows, shape[0], shape[0] * shape[1]);
     model.evaluateInStrips(u_strips, v_strips, stage_position, strips.force, strips, hooks, strip_nodes);
+    if (!seam_rows.empty()) {
+      EXPECT_EQ(hooks.threads(), seam_rows.size() + 1);  // a thread for each block
+    }
     EXPECT_TRUE(hooks.eachOnce());
     EXPECT_TRUE(hooks.untouchedForceAtPrepare());
     EXPECT_TRUE((strips.force.array() == whole.force.array()).all());
@@ -113,10 +119,18 @@ TEST(LatticeThreads, BlocksOfRowsOnThreadsGiveTheForcesOfOneSweepBitForBit) {
       SCOPED_TRACE(threads);
       Lattice2D threaded(scene);
       threaded.setThreads(threads);
-      EXPECT_EQ(threaded.threadedBlocks(), std::min(threads, 5));
+      const int blocks = threaded.threadedBlocks();
+      EXPECT_EQ(blocks, std::min(threads, 5));
       EXPECT_EQ(threaded.successiveEvaluations(), 1);
+      std::vector<int> seam_rows;
+      for (int block = 1; block < blocks; ++block) {
+        seam_rows.push_back(threaded.firstRowOfBlock(block, blocks));
+        EXPECT_EQ(seam_rows.back() % Lattice2D::kPowerBandRows, 0);
+        EXPECT_GT(seam_rows.back(), block == 1 ? 0 : seam_rows[block - 2]);
+      }
       // Strips of one row, of several rows, of more rows than a band, and the whole lattice.
-      expectStripsGiveOneSweep(threaded, u, 1e-5, {1, 5 * 45, 10 * 45, threaded.dofCount()}, 0.0, &one_thread);
+      expectStripsGiveOneSweep(threaded, u, 1e-5, {1, 5 * 45, 10 * 45, threaded.dofCount()}, 0.0, &one_thread,
+                               seam_rows);
     }
   }
   // Below the size where threads pay, none are used.

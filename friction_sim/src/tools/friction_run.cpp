@@ -52,16 +52,17 @@ int help() {
 }
 
 struct Arguments {
-  std::string scene_path, out_dir, commands_path, protocol_path, threads = "1";
+  std::string scene_path, out_dir, commands_path, protocol_path, threads_text = "1";
+  int threads = 1;
   std::vector<std::pair<std::string, std::string>> overrides;
 };
 
-/// The thread count --threads gives, if it is a whole number from 1.
-std::optional<int> threadCount(const Arguments& args) {
+/// The thread count `text` (--threads) gives, if it is a whole number from 1.
+std::optional<int> threadCount(const std::string& text) {
   std::size_t end = 0;
   try {
-    const int threads = std::stoi(args.threads, &end);
-    if (end == args.threads.size() && threads >= 1) return threads;
+    const int threads = std::stoi(text, &end);
+    if (end == text.size() && threads >= 1) return threads;
   } catch (const std::logic_error&) {
   }
   return std::nullopt;
@@ -78,7 +79,7 @@ std::optional<int> parseArguments(int argc, char** argv, Arguments& args) {
   const std::map<std::string, std::string*> paths = {{"--out", &args.out_dir},
                                                      {"--commands", &args.commands_path},
                                                      {"--protocol", &args.protocol_path},
-                                                     {"--threads", &args.threads}};
+                                                     {"--threads", &args.threads_text}};
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
     if ((paths.count(arg) > 0 || arg == "--set") && i + 1 == argc) return refuseCommandLine(arg + " needs a value");
@@ -101,7 +102,9 @@ std::optional<int> parseArguments(int argc, char** argv, Arguments& args) {
   if (!args.commands_path.empty() && !args.protocol_path.empty()) {
     return refuseCommandLine("--commands and --protocol both drive the stage; give one");
   }
-  if (!threadCount(args)) return refuseCommandLine("--threads " + args.threads + ": allowed: a whole number from 1");
+  const std::optional<int> threads = threadCount(args.threads_text);
+  if (!threads) return refuseCommandLine("--threads " + args.threads_text + ": allowed: a whole number from 1");
+  args.threads = *threads;
   return std::nullopt;
 }
 
@@ -172,7 +175,7 @@ int run(int argc, char** argv) {
   // A recorded time is its step's rounded to whole nanoseconds: due within half of one. A protocol's
   // times are the ones the rig compared its clock with: due exactly then.
   options.command_early = args.commands_path.empty() ? 0.0 : 0.5e-9;
-  options.threads = *threadCount(args);
+  options.threads = args.threads;
   friction::RunDriver driver(scene, stability_limit, options);
   const friction::Simulation& simulation = driver.simulation();
   const std::size_t scheduled_commands = scheduleCommands(args, protocol, driver);

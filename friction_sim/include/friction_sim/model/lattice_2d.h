@@ -57,9 +57,12 @@ class Lattice2D : public Model {
   void setThreads(int threads) override;
   /// The row blocks an evaluation is split into, one per thread (1: no threads).
   int threadedBlocks() const;
+  /// The first row of block `block` of `blocks` (nodesZ() for block == blocks): whole bands of rows.
+  int firstRowOfBlock(int block, int blocks) const;
   /// Rows over which the viscous power is summed column by column before the bands are added up in
   /// order: a thread's block is whole bands, so the sum is the same whatever the blocks.
   static constexpr int kPowerBandRows = 8;
+  static_assert(kPowerBandRows >= 3, "a block reads two rows beyond its first before its seam's wait");
   /// Below this many nodes a second thread gains little. A step on two threads against one (ns per
   /// node-step, medians of 5 interleaved, AMD EPYC Zen 1, 2026-11-26): 29 × 16 about 1.1×, 33 × 31 1.16×,
   /// 57 × 31 1.21×, 113 × 61 1.51×, 225 × 121 1.76×, 449 × 241 1.85×.
@@ -167,8 +170,8 @@ class Lattice2D : public Model {
   /// What the sweeps of two neighbouring row blocks tell each other: the upper one has prepared the rows
   /// at the seam and read their state, and the lower one has swept its last row (read the upper one's
   /// first row for the last time).
-  struct BlockHandoff {
-    std::atomic<bool> upper_started{false}, lower_swept{false};
+  struct alignas(64) BlockHandoff {  // a cache line each: the threads poll them
+    std::atomic<bool> seam_prepared{false}, lower_swept{false};
   };
   /// One force evaluation, row by row (lattice_2d.cpp).
   class Sweep;

@@ -63,7 +63,9 @@ struct ForceEvaluation {
 
 /// Lets a caller fuse its own passes over the state into a force evaluation, strip by strip, while the
 /// strip is in cache: at 10⁶ nodes separate passes are bound by memory bandwidth. Each hook gets a range
-/// [first, end) of degrees of freedom; by default they do nothing.
+/// [first, end) of degrees of freedom; by default they do nothing. With threads (Model::setThreads) the
+/// hooks are called from several threads at once, on disjoint ranges and in no set order across them: a
+/// hook may touch only its own range's degrees of freedom (and the interface's, which one thread finishes).
 class StripHooks {
  public:
   virtual ~StripHooks() = default;

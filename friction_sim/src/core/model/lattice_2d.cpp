@@ -79,7 +79,8 @@ void Lattice2D::forEachBond(const BondFamily& family, Visit&& visit) const {
 }
 
 void Lattice2D::setThreads(int threads) {
-  threads_ = std::max(1, threads);
+  // No more threads than bands of rows: each block is at least a band.
+  threads_ = std::clamp(threads, 1, static_cast<int>(sums_[0].band_power.size()));
   sweep_space_.resize(std::max(kSuccessiveSweeps, threads_));
   for (SweepSpace& space : sweep_space_) {
     space.horizontal_x.assign(nx_ + 2, 0.0);
@@ -91,10 +92,7 @@ void Lattice2D::setThreads(int threads) {
   handoffs_ = std::vector<BlockHandoff>(threads_ - 1);
 }
 
-int Lattice2D::threadedBlocks() const {
-  const int bands = static_cast<int>(sums_[0].band_power.size());
-  return threads_ > 1 && n_ >= kThreadedNodes ? std::min(threads_, bands) : 1;
-}
+int Lattice2D::threadedBlocks() const { return threads_ > 1 && n_ >= kThreadedNodes ? threads_ : 1; }
 
 double Lattice2D::topSpringForce(const Vector& u, int i) const {
   return mattress_k_ * (plate_z_ - u[zDof(nodeIndex(i, nz_ - 1))]);
@@ -209,6 +207,10 @@ class Lattice2D::Sweep {
         finished_rows_(block.lower ? block.first_row + 1 : block.first_row),
         next_pushed_(std::lower_bound(lattice.pushed_rows_.begin(), lattice.pushed_rows_.end(), block.first_row) -
                      lattice.pushed_rows_.begin()) {
+    // Two blocks writing one band's power would go unnoticed: refused here.
+    if (block.lower && block.first_row % kPowerBandRows != 0) {
+      throw std::logic_error("Lattice2D::Sweep: a block must start on a band of rows");
+    }
     space_.column_power.setZero();
     space_.below.clear();
   }
@@ -222,7 +224,8 @@ class Lattice2D::Sweep {
   bool done() const { return row_ == block_.end_row; }
   ForceEvaluation& output() const { return evaluation_.out; }
   /// Rows [0, finishedRows()) are finished: their forces final, their finish hooks called, their state
-  /// no longer read.
+  /// no longer read. For a sweep of the whole lattice (evaluateSuccessiveInStrips); a block above another
+  /// finishes its first row last.
   int finishedRows() const { return finished_rows_; }
   /// Rows [0, preparedRowsForNextRow()) are prepared once the next row is swept: the bonds of row j
   /// read rows j and j + 1, and rows are prepared a strip at a time. Of a block below another, the rows
@@ -247,9 +250,9 @@ class Lattice2D::Sweep {
       // The bonds up from the row below, which the lower block sweeps too; their power is counted there.
       upwardBonds(j - 1, space_.below);
       space_.column_power.setZero();
-      block_.lower->upper_started.store(true, std::memory_order_release);
+      block_.lower->seam_prepared.store(true, std::memory_order_release);
     }
-    if (block_.upper && j + 2 > prepare_end_) awaitFlag(block_.upper->upper_started, *block_.abandoned);
+    if (block_.upper && j + 2 > prepare_end_) awaitFlag(block_.upper->seam_prepared, *block_.abandoned);
     double* fx = evaluation_.force.data();
     double* fz = evaluation_.force.data() + n;
     const double* ux = evaluation_.u.data();
@@ -393,37 +396,43 @@ void Lattice2D::evaluateInStrips(const Vector& u, const Vector& v, double stage_
 
 void Lattice2D::sweepInBlocks(const StripEvaluation& evaluation, int strip_nodes, int blocks) const {
   for (int k = 0; k + 1 < blocks; ++k) {
-    handoffs_[k].upper_started.store(false, std::memory_order_relaxed);
+    handoffs_[k].seam_prepared.store(false, std::memory_order_relaxed);
     handoffs_[k].lower_swept.store(false, std::memory_order_relaxed);
   }
-  const int bands = static_cast<int>(sums_[0].band_power.size());
   std::atomic<bool> abandoned{false};
   std::exception_ptr error;
   std::mutex error_mutex;
 #pragma omp parallel num_threads(blocks)
   {
-    // As many blocks as threads came, each of whole bands of rows, as even as the bands allow; the first
-    // block, with the interface's friction, rounded down.
-    const int count = omp_get_num_threads(), k = omp_get_thread_num();
-    auto first_row = [&](int block) {
-      if (block == count) return nz_;
-      int band = 0;
-      for (int b = 1; b <= block; ++b)
-        band = std::max(band + 1, std::min(nz_ * b / count / kPowerBandRows, bands - count + b));
-      return band * kPowerBandRows;
-    };
-    const Sweep::Block block{first_row(k), first_row(k + 1), k > 0 ? &handoffs_[k - 1] : nullptr,
-                             k + 1 < count ? &handoffs_[k] : nullptr, &abandoned};
+    // As many blocks as threads came (OpenMP may give fewer).
+    const int team = omp_get_num_threads(), k = omp_get_thread_num();
+    const Sweep::Block block{firstRowOfBlock(k, team), firstRowOfBlock(k + 1, team),
+                             k > 0 ? &handoffs_[k - 1] : nullptr, k + 1 < team ? &handoffs_[k] : nullptr, &abandoned};
     try {
       Sweep sweep(*this, evaluation, strip_nodes, sweep_space_[k], sums_[0], block);
       while (!sweep.done()) sweep.sweepRow();
     } catch (...) {
+      // The error first: a neighbour that sees `abandoned` throws one of its own, which must not win.
+      {
+        const std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
       abandoned.store(true);
-      const std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = std::current_exception();
     }
   }
   if (error) std::rethrow_exception(error);
+}
+
+int Lattice2D::firstRowOfBlock(int block, int blocks) const {
+  if (block == blocks) return nz_;
+  // Whole bands, each block's share of the rows rounded to the nearest band, and at least a band each.
+  const int bands = static_cast<int>(sums_[0].band_power.size());
+  int band = 0;
+  for (int b = 1; b <= block; ++b) {
+    const int nearest = (2 * nz_ * b + blocks * kPowerBandRows) / (2 * blocks * kPowerBandRows);
+    band = std::max(band + 1, std::min(nearest, bands - blocks + b));
+  }
+  return band * kPowerBandRows;
 }
 
 int Lattice2D::evaluateSuccessiveInStrips(int strip_nodes,
