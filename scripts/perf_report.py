@@ -40,7 +40,7 @@ REMAINDER_SIZE = "32/32"
 # The lattices a naive step of the same bulk (benchmarks/naive_lattice.h) is measured on, for scale.
 NAIVE_SIZES = ["57/31", "225/121", "1001/1001"]
 # The lattices stepped on two threads (latticeStepOnThreads), against latticeStep on one.
-THREADED_SIZES = ["57/31", "225/121", "449/241", "1001/1001"]
+THREADED_SIZES = ["57/31", "113/61", "225/121", "449/241", "1001/1001"]
 # The cases the report reads by name: a bench_kernels built before one of them was added is refused at
 # the start rather than at the end of the run.
 REQUIRED_CASES = (["latticeStep/geometric/" + size for size in LATTICE_SIZES + [REMAINDER_SIZE]] +

@@ -105,6 +105,7 @@ void latticeStepOnThreads(benchmark::State& state) {
 }
 BENCHMARK(latticeStepOnThreads)
     ->Args({57, 31, 2})
+    ->Args({113, 61, 2})
     ->Args({225, 121, 2})
     ->Args({449, 241, 2})
     ->Args({1001, 1001, 2})

@@ -64,8 +64,8 @@ class Lattice2D : public Model {
   static constexpr int kPowerBandRows = 8;
   static_assert(kPowerBandRows >= 3, "a block reads two rows beyond its first before its seam's wait");
   /// Below this many nodes a second thread gains little. A step on two threads against one (ns per
-  /// node-step, medians of 5 interleaved, AMD EPYC Zen 1, 2026-11-26): 29 × 16 about 1.1×, 33 × 31 1.16×,
-  /// 57 × 31 1.21×, 113 × 61 1.51×, 225 × 121 1.76×, 449 × 241 1.85×.
+  /// node-step, medians of 5 interleaved, AMD EPYC Zen 1, 2026-11-26/27): 29 × 16 about 1.1×, 33 × 31
+  /// 1.16×, 57 × 31 1.56×, 113 × 61 1.55×, 225 × 121 1.70×, 449 × 241 1.87×.
   static constexpr int kThreadedNodes = 1000;
   /// The foundation's force k_f·(−u_z) on each bottom node.
   Vector signedNormalForces(const Vector& u, const ForceEvaluation& evaluation) const override;
