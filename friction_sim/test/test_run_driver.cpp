@@ -192,6 +192,24 @@ TEST(RunDriver, StreamsWithAnEventRateKeepTheIdleClockAcrossCreepSteps) {
   expectEventAndIdleRates(scene, false);
 }
 
+TEST(RunDriver, RatesSetAgainUnchangedLeaveTheClocksAlone) {
+  // dynamic_reconfigure's first call carries the settings as they are: no stream may take a sample early.
+  CameraStream camera({1e5, 100.0}, [](const InterfaceFrame&) {});
+  SampledStream<Instant> gauges(
+      {1e5, 1e3}, Sampling::AtSteps, [](const Simulation& s) { return Instant{s.time()}; }, [](const Instant&) {});
+  EXPECT_EQ(camera.nextTime(), 0.01);
+  EXPECT_EQ(gauges.nextTime(), 1e-3);
+  camera.setRates({1e5, 100.0}, 0.002);
+  gauges.setRates({1e5, 1e3}, 0.0002);
+  EXPECT_EQ(camera.nextTime(), 0.01);
+  EXPECT_EQ(gauges.nextTime(), 1e-3);
+  // New rates bring the next sample within a period of the camera's fastest and of the stream's idle one.
+  camera.setRates({2e5, 100.0}, 0.002);
+  gauges.setRates({1e5, 1e4}, 0.0002);
+  EXPECT_DOUBLE_EQ(camera.nextTime(), 0.002 + 5e-6);
+  EXPECT_DOUBLE_EQ(gauges.nextTime(), 0.0002 + 1e-4);
+}
+
 TEST(RunDriver, PacedRunsEndTheirJumpsAtTheCamerasFrames) {
   // Cut at frames, every idle frame of the stuck block is a jump's end, at its time on the clock; uncut,
   // one jump covers the whole 0.1 s and its frames are interpolated.

@@ -62,6 +62,7 @@ struct SampleRates {
   /// One rate for both.
   static SampleRates uniform(double rate) { return {rate, rate}; }
   double fastest() const { return std::max(during_events, idle); }
+  bool operator==(const SampleRates& other) const { return during_events == other.during_events && idle == other.idle; }
 };
 
 /// A stream of readings (any type with a `time` in s and an `interpolate(a, b, t)`) sampled at its rates,
@@ -89,8 +90,9 @@ class SampledStream : public RunStream {
   /// True if the last advance produced a sample.
   bool sampledLast() const { return sampled_last_; }
   /// New rates from simulated time `now` (s): the next sample within an idle period (an event's next step
-  /// brings it within an event period).
+  /// brings it within an event period). The same rates again change nothing.
   void setRates(SampleRates rates, double now) {
+    if (rates == rates_) return;
     rates_ = rates;
     next_ = std::min(next_, now + 1.0 / rates.idle);
   }
@@ -154,8 +156,10 @@ class CameraStream : public RunStream {
   CameraStream(SampleRates rates, Sink sink);
   double nextTime() const override { return next_; }
   /// New rates from simulated time `now` (s): the next frame within a period of the faster one (one frame
-  /// early at most, where all sticks).
+  /// early at most, where all sticks). The same rates again change nothing: dynamic_reconfigure's first
+  /// call, with the settings as they are, adds no frame.
   void setRates(SampleRates rates, double now) {
+    if (rates == rates_) return;
     rates_ = rates;
     next_ = std::min(next_, now + 1.0 / rates.fastest());
   }
