@@ -18,6 +18,7 @@ import json
 import math
 import os
 import random
+import re
 import statistics
 import subprocess
 import sys
@@ -93,8 +94,7 @@ def timed_run(runner, settings, threads, out):
     subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     wall = time.monotonic() - start
     with open(os.path.join(out, "summary.txt")) as handle:
-        steps = int(next(word for line in handle if " steps of " in line
-                         for word in [line.split(" in ")[1].split()[0]]))
+        steps = int(re.search(r"in ([0-9]+) steps", handle.read()).group(1))
     with open(os.path.join(out, "events.csv")) as handle:
         events = [(row["onset_time_s"], row["global"]) for row in csv.DictReader(handle)]
     return wall, steps, events

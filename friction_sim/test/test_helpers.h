@@ -131,7 +131,7 @@ class RecordingHooks : public StripHooks {  // each dof's records are its own: t
   }
   void prepare(int first, int end) override {
     noteThread();
-    if (atSeam(first)) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (atSeam(first)) std::this_thread::sleep_for(kSeamStall);
     for (int i = first; i < end; ++i) {
       ++prepared_[i];
       if (!std::isnan(force_[i])) untouched_force_at_prepare_ = false;
@@ -140,12 +140,6 @@ class RecordingHooks : public StripHooks {  // each dof's records are its own: t
   }
   void finish(int first, int end) override {
     noteThread();
-    struct StallAfter {
-      bool stall;
-      ~StallAfter() {
-        if (stall) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      }
-    } stall_after{atSeam(end)};
     for (int i = first; i < end; ++i) {
       ++finished_[i];
       forces_at_finish_[i] = force_[i];
@@ -154,6 +148,7 @@ class RecordingHooks : public StripHooks {  // each dof's records are its own: t
       if (normal_force_ && node >= 0 && node < normal_force_->size())
         normal_forces_at_finish_[i] = (*normal_force_)[node];
     }
+    if (atSeam(end)) std::this_thread::sleep_for(kSeamStall);
   }
   bool eachOnce() const {
     return std::all_of(prepared_.begin(), prepared_.end(), [](int n) { return n == 1; }) &&
@@ -175,6 +170,7 @@ class RecordingHooks : public StripHooks {  // each dof's records are its own: t
   std::vector<int> prepared_, finished_;
   Vector forces_at_finish_, normal_forces_at_finish_;
   std::atomic<bool> untouched_force_at_prepare_{true};  ///< threads may prepare strips at once
+  static constexpr std::chrono::milliseconds kSeamStall{5};
   std::vector<int> seam_rows_;
   int nodes_x_ = 1, nodes_ = 0;
   mutable std::mutex threads_mutex_;
