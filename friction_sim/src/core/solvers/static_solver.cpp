@@ -82,7 +82,7 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
     return;
   }
   const SparseMatrix reduced = freeStiffness(model, lifted_nodes, position_in_free, free_count, true);
-  factor_ = std::make_unique<Eigen::CholmodSupernodalLLT<SparseMatrix>>(reduced);
+  factor_ = std::make_unique<Eigen::CholmodSimplicialLLT<SparseMatrix>>(reduced);
   if (factor_->info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
 }
 
