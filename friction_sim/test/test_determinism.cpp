@@ -22,7 +22,7 @@ struct Pin {
 
 constexpr Pin kPins[] = {
     {"single_block", 0x33ff500570b44db8ULL}, {"pmma_1d_side", 0xc6d4860699d8b4b1ULL},
-    {"pmma_1d_top", 0xeac908209bc0976fULL},  {"pmma_2d", 0x45d5a7356e2014ffULL},
+    {"pmma_1d_top", 0xeac908209bc0976fULL},  {"pmma_2d", 0xaea0b03cb8599296ULL},
     {"rate_state", 0x4ccef46cce7c4279ULL},
 };
 

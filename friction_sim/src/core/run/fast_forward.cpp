@@ -39,7 +39,15 @@ StaticSolver* FastForward::pinnedSolver() {
           std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
     } catch (const std::runtime_error&) {
       // Singular: too few nodes in contact hold the slider.
+      return nullptr;
     }
+    // The pusher's force is affine in the stage's position: one solve gives the response to it for
+    // every jump with this solver.
+    ForceEvaluation here, moved;
+    const Vector at_rest = Vector::Zero(sim_.u_.size());
+    sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position(), here);
+    sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position() + 1.0, moved);
+    stage_response_ = pinned_solver_->response(moved.force - here.force);
   }
   return pinned_solver_.get();
 }
@@ -126,7 +134,7 @@ bool FastForward::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   toward_threshold = false;
   StaticSolver* solver = pinnedSolver();
   if (!(span > s.dt_) || !solver) return false;
-  Path path = pathAhead(*solver, span);
+  Path path = pathAhead(span);
   if (!(path.length > s.dt_)) {
     approaching_threshold_ = path.stops_at_threshold;
     approach_velocity_ = s.stage_.velocity();
@@ -141,7 +149,7 @@ bool FastForward::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   return true;
 }
 
-FastForward::Path FastForward::pathAhead(StaticSolver& solver, double span) {
+FastForward::Path FastForward::pathAhead(double span) {
   const Simulation& s = sim_;
   const Model& model = *s.model_;
   Path path;
@@ -150,17 +158,13 @@ FastForward::Path FastForward::pathAhead(StaticSolver& solver, double span) {
   path.velocity = Vector::Zero(s.u_.size());
   const double speed = s.stage_.velocity();
   if (speed == 0.0) return path;
-  // The pusher's force per unit stage travel, and the free nodes' response to it.
-  ForceEvaluation here, moved;
-  const Vector at_rest = Vector::Zero(s.u_.size());
-  model.evaluate(s.u_, at_rest, s.stage_.position(), here);
-  model.evaluate(s.u_, at_rest, s.stage_.position() + 1.0, moved);
-  path.along = solver.response(moved.force - here.force);
+  path.along = stage_response_;
   // Friction needed and normal force of every stuck node are affine in the stage position. Along the
   // path every free node moves at speed·along, and the pair damping's force on the stuck nodes
   // counts towards their thresholds, as it does once the dynamics takes over.
   path.velocity = speed * path.along;
   const double probe = 1e-6 * model.nodeSpacing();
+  ForceEvaluation here, moved;
   model.evaluate(s.u_, path.velocity, s.stage_.position(), here);
   const Vector probed = s.u_ + probe * path.along;
   model.evaluate(probed, path.velocity, s.stage_.position() + probe, moved);

@@ -61,7 +61,7 @@ class FastForward {
   bool jumpAlongEquilibrium(double until, bool& toward_threshold);
   /// The path from here with the stage at its speed, and the first threshold crossing, lift-off or
   /// landing along it.
-  Path pathAhead(StaticSolver& solver, double span);
+  Path pathAhead(double span);
   /// Shortens `path` to the first time a node reaches its threshold or loses contact, or a lifted node lands.
   /// `here` and `moved` are the forces at the start and at `probed`, `probe` (m) of stage travel along it.
   void findFirstCrossing(Path& path, const ForceEvaluation& here, const ForceEvaluation& moved, const Vector& probed,
@@ -108,6 +108,7 @@ class FastForward {
   double next_creep_resume_ = 0.0;               ///< s, creepResumeDue's next time
   std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
   std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
+  Vector stage_response_;                        ///< du/dX_s (m/m), the free nodes' linear response to the stage
   bool quasi_static_ = false;
   bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
   double approach_velocity_ = 0.0;      ///< m/s, the stage's velocity then: the crossing is that motion's
