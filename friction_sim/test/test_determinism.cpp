@@ -21,9 +21,9 @@ struct Pin {
 };
 
 constexpr Pin kPins[] = {
-    {"single_block", 0x33ff500570b44db8ULL}, {"pmma_1d_side", 0xc6d4860699d8b4b1ULL},
-    {"pmma_1d_top", 0xeac908209bc0976fULL},  {"pmma_2d", 0xaea0b03cb8599296ULL},
-    {"rate_state", 0x4ccef46cce7c4279ULL},
+    {"single_block", 0x33ff500570b44db8ULL}, {"pmma_1d_side", 0xefe502c3334be423ULL},
+    {"pmma_1d_top", 0x40584551a61e4f73ULL},  {"pmma_2d", 0x05199d9fa13774d2ULL},
+    {"rate_state", 0x03eab833bf944af1ULL},
 };
 
 void PrintTo(const Pin& pin, std::ostream* out) { *out << pin.scene; }

@@ -92,17 +92,17 @@ bool FastForward::jump(double until) {
   if (creep_.enabled() && (sim_.contact_.slidingCount() > 0 || approaching_threshold_)) return creepStep(until);
   // A jump aimed at a threshold uses the equilibrium's slope where it starts; the slope changes along
   // the way (the springs' geometry), so a long jump would land off the crossing by a part in 10⁴ of
-  // the load. Approached instead in jumps that each cover a fixed share of what is left, from a slope
-  // taken ever closer to the crossing, until less than a step is left: then the dynamics takes the
-  // node over, and the result no longer depends on where the jumps were cut (`until`).
+  // the load. Approached instead in jumps that each cover a share of what is left (approachShare), from
+  // a slope taken ever closer to the crossing, until less than a step is left: then the dynamics takes
+  // the node over, and the result no longer depends on where the jumps were cut (`until`).
   bool jumped = false;
-  bool toward_threshold = true;
-  for (int jump = 1; toward_threshold && jumpAlongEquilibrium(until, toward_threshold); ++jump) {
+  Approach approach;
+  for (int jump = 1; approach.toward_threshold && jumpAlongEquilibrium(until, approach); ++jump) {
     jumped = true;
     if (sim_.event_started_ || sim_.finished()) break;
     // A crossing that keeps receding (met tangentially) is left to the dynamics.
     if (jump == kMaxApproachJumps) {
-      approaching_threshold_ = toward_threshold;
+      approaching_threshold_ = approach.toward_threshold;
       approach_velocity_ = sim_.stage_.velocity();
       break;
     }
@@ -128,10 +128,23 @@ double FastForward::endTime(double until, double length) const {
   return length == end - sim_.time_ ? end : sim_.time_ + length;
 }
 
-bool FastForward::jumpAlongEquilibrium(double until, bool& toward_threshold) {
+double FastForward::approachShare(const Approach& approach, const Path& path) {
+  if (!(approach.length > 0.0)) return kApproachShare;
+  // An estimate misses by a share of the way jumped: the last jump measured that share for every node
+  // that may cross soon, not only the first (a node's crossing may come sooner than estimated).
+  double miss = 0.0;
+  for (std::size_t node = 0; node < path.crossings.size(); ++node) {
+    if (path.crossings[node] < kApproachNeighbourhood * path.length) {
+      miss = std::max(miss, std::abs(path.crossings[node] - approach.expected_left[node]) / approach.length);
+    }
+  }
+  return std::clamp(1.0 - kApproachSafety * miss, kApproachShare, kLongestApproachShare);
+}
+
+bool FastForward::jumpAlongEquilibrium(double until, Approach& approach) {
   const Simulation& s = sim_;
   const double span = spanAhead(until);
-  toward_threshold = false;
+  approach.toward_threshold = false;
   StaticSolver* solver = pinnedSolver();
   if (!(span > s.dt_) || !solver) return false;
   Path path = pathAhead(span);
@@ -143,8 +156,13 @@ bool FastForward::jumpAlongEquilibrium(double until, bool& toward_threshold) {
   // With nothing due, no end and no threshold ahead (a stage at rest) the jump has no end: nothing
   // would change along it, and a jump to t = inf would leave NaN behind; the caller steps or bounds it.
   if (!std::isfinite(path.length)) return false;
-  if (path.stops_at_threshold) path.length *= kApproachShare;
-  toward_threshold = path.stops_at_threshold;
+  if (path.stops_at_threshold) {
+    path.length *= approachShare(approach, path);
+    approach.toward_threshold = true;
+    approach.length = path.length;
+    approach.expected_left = path.crossings;
+    for (double& left : approach.expected_left) left -= path.length;
+  }
   takeJump(*solver, path, path.stops_at_threshold ? s.time_ + path.length : endTime(until, path.length));
   return true;
 }
@@ -177,7 +195,9 @@ void FastForward::findFirstCrossing(Path& path, const ForceEvaluation& here, con
   const Simulation& s = sim_;
   const ContactInterface& contact = s.contact_;
   const double speed = s.stage_.velocity();
-  auto stop_at = [&path](double time) {
+  path.crossings.assign(contact.size(), std::numeric_limits<double>::infinity());
+  auto stop_at = [&path](int node, double time) {
+    path.crossings[node] = std::min(path.crossings[node], time);
     if (time < path.length) {
       path.length = time;
       path.stops_at_threshold = true;
@@ -192,7 +212,7 @@ void FastForward::findFirstCrossing(Path& path, const ForceEvaluation& here, con
   for (int node = 0; node < contact.size(); ++node) {
     if (contact.state(node) == ContactState::Detached) {
       const double lift_rate = (lift_moved[node] - lift[node]) / probe * speed;
-      if (lift_rate > 0.0) stop_at(-lift[node] / lift_rate);
+      if (lift_rate > 0.0) stop_at(node, -lift[node] / lift_rate);
       continue;
     }
     const int dof = contact.dofs()[node];
@@ -205,9 +225,9 @@ void FastForward::findFirstCrossing(Path& path, const ForceEvaluation& here, con
       const double slope = sign * force_rate - mu * normal_rate;
       if (!(slope > 0.0)) continue;
       const double crossing = (mu * normal - sign * force) / slope;
-      stop_at(ageing ? agedCrossing(node, sign, force, force_rate, normal, normal_rate, crossing) : crossing);
+      stop_at(node, ageing ? agedCrossing(node, sign, force, force_rate, normal, normal_rate, crossing) : crossing);
     }
-    if (normal_rate < 0.0) stop_at(-normal / normal_rate);
+    if (normal_rate < 0.0) stop_at(node, -normal / normal_rate);
   }
 }
 

@@ -54,11 +54,22 @@ class FastForward {
     Vector velocity;      ///< m/s, every free node moves with the stage
     double length = 0.0;  ///< s, to the caller's time, the stage's next change, a stop limit or the first threshold
     bool stops_at_threshold = false;
+    std::vector<double> crossings;  ///< s, each interface node's estimated first crossing (inf: none)
+  };
+  /// The jumps of one fast-forward towards a threshold crossing, as far as the last one went.
+  struct Approach {
+    bool toward_threshold = true;       ///< the last jump stopped short of a crossing
+    double length = 0.0;                ///< s, that jump's (0: none yet)
+    std::vector<double> expected_left;  ///< s, each node's way to its crossing that the jump estimated it would leave
   };
   /// One jump along the pinned equilibrium towards `until` or, if sooner, the next node's threshold
-  /// (then `toward_threshold`, and the jump covers kApproachShare of the way). Returns false, jumping
-  /// nowhere, if less than a step is left.
-  bool jumpAlongEquilibrium(double until, bool& toward_threshold);
+  /// (then `approach.toward_threshold`, and the jump covers approachShare of the way). Returns false,
+  /// jumping nowhere, if less than a step is left.
+  bool jumpAlongEquilibrium(double until, Approach& approach);
+  /// Share of the way along `path` to its first crossing that the next jump of `approach` covers: the
+  /// first kApproachShare, each later one leaving kApproachSafety times the error that the last jump's
+  /// misses predict for it, within [kApproachShare, kLongestApproachShare].
+  static double approachShare(const Approach& approach, const Path& path);
   /// The path from here with the stage at its speed, and the first threshold crossing, lift-off or
   /// landing along it.
   Path pathAhead(double span);
@@ -94,9 +105,15 @@ class FastForward {
   /// What every advance along the path ends with: the kinetic energy it changed, the pusher's work, slip
   /// events over [`event_start`, + `event_length`] (s), the jump count and the stop condition.
   void concludeAdvance(const AdvanceStart& start, double event_start, double event_length);
-  /// Share of the way to an estimated threshold crossing that one jump covers.
+  /// Share of the way to an estimated threshold crossing that a jump covers at least.
   static constexpr double kApproachShare = 0.9;
-  /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about five).
+  /// ... and at most: what is left is never less than a thousandth of the estimate.
+  static constexpr double kLongestApproachShare = 0.99;
+  /// The margin left before a crossing, in the error predicted for the jump.
+  static constexpr double kApproachSafety = 10.0;
+  /// The nodes whose misses count: those estimated to cross within this many times the way to the first.
+  static constexpr double kApproachNeighbourhood = 10.0;
+  /// Jumps of one fast-forward after which the dynamics takes over (an approach takes about three).
   static constexpr int kMaxApproachJumps = 50;
   /// The dynamics takes a threshold's approach over while the stage keeps the velocity that brings the
   /// crossing; another motion (a hold, a reversal: a command or a segment of the program) may never
