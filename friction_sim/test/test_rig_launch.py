@@ -362,7 +362,9 @@ class RigLaunchStatusTest(unittest.TestCase):
             flood.stdin.write("go\n")
             flood.stdin.flush()
             self.assertEqual(flood.stdout.readline().strip(), "sent")
-            threading.Event().wait(1.0)
+            # "sent" means queued in rospy; its writer thread fills the socket while the simulator is
+            # stopped, and on a host busy with other tests one second was not always enough (0 dropped).
+            threading.Event().wait(3.0)
             os.kill(run.simulator, signal.SIGCONT)
             flood.communicate(timeout=60)
             state = subprocess.run(client(run.lines, ["rostopic", "echo", "-n", "1",
