@@ -421,14 +421,15 @@ TEST(QuasiStaticCreep, CreepingSliderHasTheFullDynamicsPrecursors) {
   EXPECT_LT(creeping.steps(), dynamic.steps() / 20);
   const auto mine = extendedPrecursors(creeping), reference = extendedPrecursors(dynamic);
   // Measured: 12 each; the first ten within 2.7e-3 in F_X/F_Z. In L_p the long precursors agree to a
-  // spacing (5 mm); the short ones between them move with round-off: the tenth is three spacings off with
-  // one factorisation of the static stiffness and two with another.
+  // spacing (5 mm); the short ones between them (shorter than the one before) move with round-off: the
+  // tenth is three spacings off with one factorisation of the static stiffness and two with another.
   ASSERT_GE(mine.size(), 10u);
   ASSERT_GE(reference.size(), 10u);
   const double spacing = scene.geometry.length / (scene.lattice.nodes_x - 1);
   for (std::size_t i = 0; i < 10; ++i) {
     EXPECT_NEAR(mine[i].first, reference[i].first, 3e-3) << "precursor " << i;
-    EXPECT_NEAR(mine[i].second, reference[i].second, 3.01 * spacing) << "precursor " << i;
+    const bool short_one = i > 0 && reference[i].second < reference[i - 1].second;
+    EXPECT_NEAR(mine[i].second, reference[i].second, (short_one ? 3.01 : 1.01) * spacing) << "precursor " << i;
   }
   const SlipEvent &global = creeping.events().back(), &global_reference = dynamic.events().back();
   EXPECT_NEAR(global.onset_shear_force / global.onset_normal_force,

@@ -38,8 +38,8 @@ class StaticSolver {
 
   /// Modified-Newton iterations after which solve() gives up.
   static constexpr int kMaxIterations = 500;
-  /// The ratio of successive corrections up to which solve() trusts its estimate of what is left.
-  static constexpr double kMostConvergentRatio = 0.5;
+  /// The ratio of successive corrections below which solve() trusts its estimate of what is left.
+  static constexpr double kLargestTrustedRatio = 0.5;
 
   /// Moves the free degrees of freedom of `u` to equilibrium with the stage at `stage_position` (m)
   /// and the extra forces `body_force` (N per dof; empty = none). The fixed ones stay as they are.

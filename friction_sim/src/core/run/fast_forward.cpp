@@ -35,19 +35,18 @@ StaticSolver* FastForward::pinnedSolver() {
       if (contact.state(node) != ContactState::Detached) in_contact.push_back(contact.dofs()[node]);
     }
     try {
-      pinned_solver_ =
-          std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
+      auto solver = std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
+      // The pusher's force is affine in the stage's position: one solve gives the response to it for
+      // every jump with this solver.
+      ForceEvaluation here, moved;
+      const Vector at_rest = Vector::Zero(sim_.u_.size());
+      sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position(), here);
+      sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position() + 1.0, moved);
+      stage_response_ = solver->response(moved.force - here.force);
+      pinned_solver_ = std::move(solver);
     } catch (const std::runtime_error&) {
-      // Singular: too few nodes in contact hold the slider.
-      return nullptr;
+      // Singular (too few nodes in contact hold the slider), or a multigrid solve that did not converge.
     }
-    // The pusher's force is affine in the stage's position: one solve gives the response to it for
-    // every jump with this solver.
-    ForceEvaluation here, moved;
-    const Vector at_rest = Vector::Zero(sim_.u_.size());
-    sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position(), here);
-    sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position() + 1.0, moved);
-    stage_response_ = pinned_solver_->response(moved.force - here.force);
   }
   return pinned_solver_.get();
 }
@@ -284,7 +283,7 @@ bool FastForward::creepStep(double until) {
   const AdvanceStart start = beginAdvance(step.duration, endTime(until, step.duration));
   s.u_ += step.displacement;
   // The step's linearised motion is within a part in 10⁴ of equilibrium: one correction leaves a part in
-  // 10⁸, and the next step corrects what is left.
+  // 10⁶ or less, and the next step corrects what is left.
   solver->correct(*s.model_, s.u_, start.stage_end);
   // The bulk at its mean velocity over the step, each creeping node at its speed at the end: the next
   // step, or the dynamics, starts from it.

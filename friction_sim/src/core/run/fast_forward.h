@@ -58,7 +58,7 @@ class FastForward {
   };
   /// The jumps of one fast-forward towards a threshold crossing, as far as the last one went.
   struct Approach {
-    bool toward_threshold = true;       ///< the last jump stopped short of a crossing
+    bool toward_threshold = true;       ///< the last jump stopped short of a crossing (true before the first)
     double length = 0.0;                ///< s, that jump's (0: none yet)
     std::vector<double> expected_left;  ///< s, each node's way to its crossing that the jump estimated it would leave
   };
@@ -107,7 +107,7 @@ class FastForward {
   void concludeAdvance(const AdvanceStart& start, double event_start, double event_length);
   /// Share of the way to an estimated threshold crossing that a jump covers at least.
   static constexpr double kApproachShare = 0.9;
-  /// ... and at most: what is left is never less than a thousandth of the estimate.
+  /// ... and at most: what is left is never less than a hundredth of the estimate.
   static constexpr double kLongestApproachShare = 0.99;
   /// The margin left before a crossing, in the error predicted for the jump.
   static constexpr double kApproachSafety = 10.0;
@@ -125,7 +125,9 @@ class FastForward {
   double next_creep_resume_ = 0.0;               ///< s, creepResumeDue's next time
   std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
   std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
-  Vector stage_response_;                        ///< du/dX_s (m/m), the free nodes' linear response to the stage
+  /// du/dX_s (m/m), the free nodes' response to the stage, solved once per solver: the models' pushers are
+  /// linear springs, whose force is affine in the stage's position and its slope independent of u.
+  Vector stage_response_;
   bool quasi_static_ = false;
   bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
   double approach_velocity_ = 0.0;      ///< m/s, the stage's velocity then: the crossing is that motion's

@@ -2,6 +2,8 @@
 
 #include "solvers/grid_multigrid.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace friction {
@@ -114,18 +116,21 @@ double StaticSolver::correct(const Model& model, Vector& u, double stage_positio
 
 int StaticSolver::solve(Model& model, Vector& u, double stage_position, const Vector& body_force) const {
   if (free_dofs_.empty()) return 0;
-  double last_correction = 0.0;
+  // Modified Newton converges linearly: each correction about `ratio` times the last, so about
+  // correction·ratio/(1 − ratio) is left after this one. Stopping on that estimate spares the solve
+  // whose only use would be to show a correction below the tolerance. The ratio is the larger of the
+  // last two, and none is taken across a change of the top load (another problem).
+  double last_correction = 0.0, last_ratio = kLargestTrustedRatio;
   for (int iteration = 1; iteration <= kMaxIterations; ++iteration) {
     const double correction = correct(model, u, stage_position, body_force);
     const bool load_changed = balance_load_ && model.rebalanceLoad(u);
-    // Modified Newton converges linearly: each correction about `ratio` times the last, so about
-    // correction·ratio/(1 − ratio) is left after this one. Stopping on that estimate spares the solve
-    // whose only use would be to show a correction below the tolerance.
-    const double ratio = correction / last_correction;
-    const bool estimated = iteration > 1 && ratio < kMostConvergentRatio;
-    const double left = estimated ? correction * ratio / (1.0 - ratio) : correction;
+    const double ratio =
+        last_correction > 0.0 && std::isfinite(last_correction) ? correction / last_correction : kLargestTrustedRatio;
+    const double trusted = std::max(ratio, last_ratio);
+    const double left = trusted < kLargestTrustedRatio ? correction * trusted / (1.0 - trusted) : correction;
     if (!load_changed && left < tolerance_) return iteration;
-    last_correction = correction;
+    last_correction = load_changed ? 0.0 : correction;
+    last_ratio = load_changed ? kLargestTrustedRatio : ratio;
   }
   return kMaxIterations + 1;
 }
