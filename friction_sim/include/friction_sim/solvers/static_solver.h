@@ -56,6 +56,8 @@ class StaticSolver {
   Vector response(const Vector& force) const;
 
   const std::vector<int>& freeDofs() const { return free_dofs_; }
+  /// m, what solve() may leave of a free degree of freedom's displacement.
+  double tolerance() const { return tolerance_; }
   /// Conjugate-gradient iterations of the last multigrid solve (0 with the direct method).
   int multigridIterations() const;
 

@@ -263,8 +263,14 @@ double FastForward::agedCrossing(int node, double sign, double force, double for
 void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   Simulation& s = sim_;
   const AdvanceStart start = beginAdvance(path.length, end_time);
-  s.u_ += (start.stage_end - start.stage_position) * path.along;
+  const double stage_move = start.stage_end - start.stage_position;
+  const Vector u_start = s.u_;
+  s.u_ += stage_move * path.along;
   solver.solve(*s.model_, s.u_, start.stage_end);
+  Vector secant = s.u_ - u_start;
+  if (solver.tolerance() <= kSecantPrecision * secant.lpNorm<Eigen::Infinity>()) {
+    stage_response_ = secant / stage_move;
+  }
   s.v_.swap(path.velocity);
   jumped_time_ += path.length;
   concludeAdvance(start, s.time_, 0.0);
