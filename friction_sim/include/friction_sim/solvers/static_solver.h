@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
 #include <memory>
 #include <vector>
 
@@ -36,6 +37,15 @@ class StaticSolver {
                StaticMethod method = StaticMethod::kAuto, const std::vector<int>& lifted_nodes = {});
   ~StaticSolver();
 
+  /// `base` turned into the solver of the same free degrees of freedom with springs added to some of them
+  /// (`added_stiffness`, N/m per dof of the model, 0 where none), by Woodbury's identity: one solve of
+  /// `base` per added spring instead of a factorisation. Null if more than kMostAddedSprings are added
+  /// (then a factorisation costs less). The result does not re-balance a top load.
+  static std::unique_ptr<StaticSolver> withAddedSprings(std::unique_ptr<StaticSolver> base,
+                                                        const Vector& added_stiffness);
+  /// Added springs up to which withAddedSprings corrects rather than factors again.
+  static constexpr int kMostAddedSprings = 16;
+
   /// Modified-Newton iterations after which solve() gives up.
   static constexpr int kMaxIterations = 500;
   /// The ratio of successive corrections below which solve() trusts its estimate of what is left.
@@ -62,6 +72,9 @@ class StaticSolver {
   int multigridIterations() const;
 
  private:
+  /// response() on the free degrees of freedom alone.
+  Vector reducedResponse(const Vector& reduced) const;
+
   std::vector<int> free_dofs_;
   /// Simplicial rather than supernodal: with the reference BLAS the supernodal factor's dense blocks gain
   /// nothing, and its OpenMP regions (four threads, fixed when CHOLMOD is built) cost thread wake-ups.
@@ -69,6 +82,12 @@ class StaticSolver {
   /// 225 × 121 and 449 × 241 (2026-11-27, AMD EPYC Zen 1, Debian's CHOLMOD 3.0.14).
   std::unique_ptr<Eigen::CholmodSimplicialLLT<SparseMatrix>> factor_;  ///< the direct method's
   std::unique_ptr<GridMultigrid> multigrid_;                           ///< or the iterative one's
+  /// Springs added by withAddedSprings: their positions among the free degrees of freedom, the factored
+  /// matrix's response to a unit force at each (one column each), and the Cholesky factor of the
+  /// capacitance matrix diag(1/k) + (those responses at those positions).
+  std::vector<int> spring_positions_;
+  Eigen::MatrixXd spring_response_;
+  Eigen::LLT<Eigen::MatrixXd> capacitance_;
   double tolerance_;
   bool balance_load_;
 };

@@ -35,7 +35,15 @@ StaticSolver* FastForward::pinnedSolver() {
       if (contact.state(node) != ContactState::Detached) in_contact.push_back(contact.dofs()[node]);
     }
     try {
-      auto solver = std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
+      std::unique_ptr<StaticSolver> solver;
+      if (loading_solver_ && lifted_nodes_.empty() && in_contact == loading_fixed_dofs_) {
+        solver = StaticSolver::withAddedSprings(std::move(loading_solver_),
+                                                sim_.model_->anchorStiffness() - loading_anchor_stiffness_);
+      }
+      loading_solver_.reset();
+      if (!solver) {
+        solver = std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
+      }
       // The pusher's force is affine in the stage's position: one solve gives the response to it for
       // every jump with this solver.
       ForceEvaluation here, moved;
@@ -49,6 +57,13 @@ StaticSolver* FastForward::pinnedSolver() {
     }
   }
   return pinned_solver_.get();
+}
+
+void FastForward::offerLoadingSolver(std::unique_ptr<StaticSolver> solver, std::vector<int> fixed_dofs,
+                                     Vector anchor_stiffness) {
+  loading_solver_ = std::move(solver);
+  loading_fixed_dofs_ = std::move(fixed_dofs);
+  loading_anchor_stiffness_ = std::move(anchor_stiffness);
 }
 
 bool FastForward::relaxToStaticEquilibrium() {

@@ -56,13 +56,16 @@ void Simulation::relaxToLoadedEquilibrium() {
   } else {
     model_->disconnectPusher();
   }
-  StaticSolver(*model_, model_->blockedDofsDuringLoading(), true).solve(*model_, u_, 0.0, body_force);
+  auto loading = std::make_unique<StaticSolver>(*model_, model_->blockedDofsDuringLoading(), true);
+  loading->solve(*model_, u_, 0.0, body_force);
+  const Vector loading_anchor_stiffness = model_->anchorStiffness();
   if (!prestressed) model_->connectPusher(u_);
   contact_.reset(u_);
   power_ = acceleration(u_, v_, 0.0, a_);
   if (contact_.updateStates(u_, v_, 0.0, node_mass_)) reapplyFriction();
   ledger_.start(model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_), u_);
   if (scene_.integrator.fast_forward) {
+    fast_forward_->offerLoadingSolver(std::move(loading), model_->blockedDofsDuringLoading(), loading_anchor_stiffness);
     fast_forward_->setQuasiStatic(contact_.slidingCount() == 0 && fast_forward_->pinnedSolver() != nullptr);
   }
 }

@@ -91,6 +91,13 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
 Vector StaticSolver::response(const Vector& force) const {
   Vector reduced(free_dofs_.size());
   for (std::size_t i = 0; i < free_dofs_.size(); ++i) reduced[i] = force[free_dofs_[i]];
+  const Vector solution = reducedResponse(reduced);
+  Vector out = Vector::Zero(force.size());
+  for (std::size_t i = 0; i < free_dofs_.size(); ++i) out[free_dofs_[i]] = solution[i];
+  return out;
+}
+
+Vector StaticSolver::reducedResponse(const Vector& reduced) const {
   Vector solution;
   if (multigrid_) {
     solution = multigrid_->solve(reduced, kMultigridTolerance);
@@ -99,9 +106,45 @@ Vector StaticSolver::response(const Vector& force) const {
   } else {
     solution = reduced;  // no free degree of freedom
   }
-  Vector out = Vector::Zero(force.size());
-  for (std::size_t i = 0; i < free_dofs_.size(); ++i) out[free_dofs_[i]] = solution[i];
-  return out;
+  if (!spring_positions_.empty()) {
+    // (K + U·D·Uᵀ)⁻¹·f = x − W·(D⁻¹ + Uᵀ·W)⁻¹·Uᵀ·x with x = K⁻¹·f and W = K⁻¹·U.
+    Eigen::VectorXd at_springs(spring_positions_.size());
+    for (std::size_t c = 0; c < spring_positions_.size(); ++c) at_springs[c] = solution[spring_positions_[c]];
+    solution -= spring_response_ * capacitance_.solve(at_springs);
+  }
+  return solution;
+}
+
+std::unique_ptr<StaticSolver> StaticSolver::withAddedSprings(std::unique_ptr<StaticSolver> base,
+                                                             const Vector& added_stiffness) {
+  std::vector<int> positions;
+  std::vector<double> stiffness;
+  for (std::size_t i = 0; i < base->free_dofs_.size(); ++i) {
+    const double k = added_stiffness[base->free_dofs_[i]];
+    if (k == 0.0) continue;
+    positions.push_back(static_cast<int>(i));
+    stiffness.push_back(k);
+  }
+  if (positions.size() > static_cast<std::size_t>(kMostAddedSprings) || !base->spring_positions_.empty()) {
+    return nullptr;
+  }
+  base->balance_load_ = false;
+  if (positions.empty()) return base;
+  const int count = static_cast<int>(positions.size());
+  Eigen::MatrixXd response(base->free_dofs_.size(), count);
+  for (int c = 0; c < count; ++c) {
+    response.col(c) = base->reducedResponse(Vector::Unit(base->free_dofs_.size(), positions[c]));
+  }
+  Eigen::MatrixXd capacitance(count, count);
+  for (int r = 0; r < count; ++r) {
+    for (int c = 0; c < count; ++c) capacitance(r, c) = response(positions[r], c);
+    capacitance(r, r) += 1.0 / stiffness[r];
+  }
+  base->capacitance_.compute(capacitance);
+  if (base->capacitance_.info() != Eigen::Success) return nullptr;
+  base->spring_positions_ = std::move(positions);
+  base->spring_response_ = std::move(response);
+  return base;
 }
 
 double StaticSolver::correct(const Model& model, Vector& u, double stage_position, const Vector& body_force) const {
