@@ -5,8 +5,8 @@
 // large for the factor's memory is solved by multigrid-preconditioned conjugate gradients instead.
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
-#include <Eigen/Dense>
 #include <memory>
 #include <vector>
 
@@ -39,8 +39,10 @@ class StaticSolver {
 
   /// `base` turned into the solver of the same free degrees of freedom with springs added to some of them
   /// (`added_stiffness`, N/m per dof of the model, 0 where none), by Woodbury's identity: one solve of
-  /// `base` per added spring instead of a factorisation. Null if more than kMostAddedSprings are added
-  /// (then a factorisation costs less). The result does not re-balance a top load.
+  /// `base` per added spring instead of a factorisation. The result does not re-balance a top load.
+  /// Null, `base` spent, where a factorisation is the better way: `base` is not a direct factor (a
+  /// multigrid solve per spring, and a dense column of every dof per spring, at 10⁶ nodes), more than
+  /// kMostAddedSprings are added, or `base` has springs added already.
   static std::unique_ptr<StaticSolver> withAddedSprings(std::unique_ptr<StaticSolver> base,
                                                         const Vector& added_stiffness);
   /// Added springs up to which withAddedSprings corrects rather than factors again.

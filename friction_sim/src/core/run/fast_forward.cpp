@@ -41,11 +41,13 @@ StaticSolver* FastForward::pinnedSolver() {
                                                 sim_.model_->anchorStiffness() - loading_anchor_stiffness_);
       }
       loading_solver_.reset();
+      loading_fixed_dofs_.clear();
+      loading_anchor_stiffness_.resize(0);
       if (!solver) {
         solver = std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
       }
-      // The pusher's force is affine in the stage's position: one solve gives the response to it for
-      // every jump with this solver.
+      // The pusher's force is affine in the stage's position: one solve gives the response to it, the
+      // path's slope until a jump's secant takes its place.
       ForceEvaluation here, moved;
       const Vector at_rest = Vector::Zero(sim_.u_.size());
       sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position(), here);
@@ -91,6 +93,7 @@ bool FastForward::relaxToStaticEquilibrium() {
                        s.ledger_.potential(*s.model_, relaxed, stage));
   s.u_ = relaxed;
   s.v_.setZero();
+  markEquilibrium(true);
   s.refreshAfterStaticChange();
   approaching_threshold_ = false;
   return true;
@@ -104,9 +107,9 @@ bool FastForward::creepResumeDue(double time) {
 
 bool FastForward::jump(double until) {
   if (creep_.enabled() && (sim_.contact_.slidingCount() > 0 || approaching_threshold_)) return creepStep(until);
-  // A jump aimed at a threshold uses the equilibrium's slope where it starts; the slope changes along
-  // the way (the springs' geometry), so a long jump would land off the crossing by a part in 10⁴ of
-  // the load. Approached instead in jumps that each cover a share of what is left (approachShare), from
+  // A jump aimed at a threshold follows the path's slope as the last jump's secant gave it; the slope
+  // changes along the way (the springs' geometry), so a long jump would land off the crossing by a part
+  // in 10⁴ of the load. Approached instead in jumps that each cover a share of what is left (approachShare), from
   // a slope taken ever closer to the crossing, until less than a step is left: then the dynamics takes
   // the node over, and the result no longer depends on where the jumps were cut (`until`).
   bool jumped = false;
@@ -277,19 +280,30 @@ double FastForward::agedCrossing(int node, double sign, double force, double for
 
 void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   Simulation& s = sim_;
+  const bool from_equilibrium = atEquilibrium();
   const AdvanceStart start = beginAdvance(path.length, end_time);
   const double stage_move = start.stage_end - start.stage_position;
   const Vector u_start = s.u_;
   s.u_ += stage_move * path.along;
-  solver.solve(*s.model_, s.u_, start.stage_end);
-  Vector secant = s.u_ - u_start;
-  if (solver.tolerance() <= kSecantPrecision * secant.lpNorm<Eigen::Infinity>()) {
+  const bool converged = solver.solve(*s.model_, s.u_, start.stage_end) <= StaticSolver::kMaxIterations;
+  const Vector secant = s.u_ - u_start;
+  // From one equilibrium to the next along the path, and long enough that the solves' error is lost in it.
+  if (converged && from_equilibrium && stage_move != 0.0 &&
+      solver.tolerance() <= kSecantPrecision * secant.lpNorm<Eigen::Infinity>()) {
     stage_response_ = secant / stage_move;
   }
+  markEquilibrium(converged);
   s.v_.swap(path.velocity);
   jumped_time_ += path.length;
   concludeAdvance(start, s.time_, 0.0);
 }
+
+void FastForward::markEquilibrium(bool at_equilibrium) {
+  at_equilibrium_ = at_equilibrium;
+  equilibrium_steps_ = sim_.steps();
+}
+
+bool FastForward::atEquilibrium() const { return at_equilibrium_ && sim_.steps() == equilibrium_steps_; }
 
 bool FastForward::creepStep(double until) {
   Simulation& s = sim_;
@@ -301,6 +315,7 @@ bool FastForward::creepStep(double until) {
     return false;
   }
   const Vector u_start = s.u_;
+  markEquilibrium(false);  // one correction: near, not at, the creep's equilibrium
   const AdvanceStart start = beginAdvance(step.duration, endTime(until, step.duration));
   s.u_ += step.displacement;
   // The step's linearised motion is within a part in 10⁴ of equilibrium: one correction leaves a part in

@@ -87,7 +87,7 @@ class FastForward {
   double agedCrossing(int node, double sign, double force, double force_rate, double normal, double normal_rate,
                       double earliest) const;
   /// Moves the slider and the stage along `path` by its length, the clock to `end_time` (s), and takes
-  /// the jump's secant as the path's slope.
+  /// the jump's secant as the path's slope if it went from one equilibrium to another.
   void takeJump(StaticSolver& solver, Path& path, double end_time);
   /// s, how far an advance towards `until` (s) may go: to `until`, the stop time, the stage's next change
   /// or its travel limit.
@@ -138,9 +138,15 @@ class FastForward {
   std::vector<int> lifted_nodes_;    ///< the interface nodes off the track it was set up for
   /// du/dX_s (m/m), the slope of the path: first the free nodes' linear response to the stage, solved once
   /// per solver (the models' pushers are linear springs, whose force is affine in the stage's position);
-  /// then the secant of each jump long enough (kSecantPrecision). The springs' geometry turns the path,
-  /// and the linear response at the loaded state misses the slope later on by a part in 200 at 225 × 121.
+  /// then the secant of each jump between equilibria long enough (kSecantPrecision): the springs' geometry
+  /// turns the path away from the loaded state's slope as the slider deforms.
   Vector stage_response_;
+  /// The state is a converged pinned equilibrium (the loaded one, a relaxation's or a jump's), as long as
+  /// no step has been taken since `equilibrium_steps_`.
+  bool at_equilibrium_ = true;
+  long long equilibrium_steps_ = 0;
+  void markEquilibrium(bool at_equilibrium);
+  bool atEquilibrium() const;
   bool quasi_static_ = false;
   bool approaching_threshold_ = false;  ///< the last jump stopped short of a threshold: step dynamically
   double approach_velocity_ = 0.0;      ///< m/s, the stage's velocity then: the crossing is that motion's

@@ -125,7 +125,8 @@ std::unique_ptr<StaticSolver> StaticSolver::withAddedSprings(std::unique_ptr<Sta
     positions.push_back(static_cast<int>(i));
     stiffness.push_back(k);
   }
-  if (positions.size() > static_cast<std::size_t>(kMostAddedSprings) || !base->spring_positions_.empty()) {
+  if (!base->factor_ || positions.size() > static_cast<std::size_t>(kMostAddedSprings) ||
+      !base->spring_positions_.empty()) {
     return nullptr;
   }
   base->balance_load_ = false;
