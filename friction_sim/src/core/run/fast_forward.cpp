@@ -20,7 +20,7 @@ bool FastForward::mayJump() const {
   return quasi_static_ && (!approachingThreshold() || creep_.enabled()) && !sim_.stageTooFast();
 }
 
-StaticSolver* FastForward::pinnedSolver() {
+StaticSolver* FastForward::pinnedSolver(LoadingSolve* loading) {
   const ContactInterface& contact = sim_.contact_;
   std::vector<int> lifted;
   for (int node = 0; node < contact.size(); ++node) {
@@ -36,13 +36,11 @@ StaticSolver* FastForward::pinnedSolver() {
     }
     try {
       std::unique_ptr<StaticSolver> solver;
-      if (loading_solver_ && lifted_nodes_.empty() && in_contact == loading_fixed_dofs_) {
-        solver = StaticSolver::withAddedSprings(std::move(loading_solver_),
-                                                sim_.model_->anchorStiffness() - loading_anchor_stiffness_);
+      if (loading && loading->solver && lifted_nodes_.empty() && in_contact == loading->fixed_dofs) {
+        solver = StaticSolver::withAddedSprings(std::move(loading->solver),
+                                                sim_.model_->anchorStiffness() - loading->anchor_stiffness);
       }
-      loading_solver_.reset();
-      loading_fixed_dofs_.clear();
-      loading_anchor_stiffness_.resize(0);
+      if (loading) loading->solver.reset();  // first, as above
       if (!solver) {
         solver = std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
       }
@@ -59,13 +57,6 @@ StaticSolver* FastForward::pinnedSolver() {
     }
   }
   return pinned_solver_.get();
-}
-
-void FastForward::offerLoadingSolver(std::unique_ptr<StaticSolver> solver, std::vector<int> fixed_dofs,
-                                     Vector anchor_stiffness) {
-  loading_solver_ = std::move(solver);
-  loading_fixed_dofs_ = std::move(fixed_dofs);
-  loading_anchor_stiffness_ = std::move(anchor_stiffness);
 }
 
 bool FastForward::relaxToStaticEquilibrium() {

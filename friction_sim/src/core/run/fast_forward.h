@@ -42,16 +42,24 @@ class FastForward {
   /// The static solver with the interface nodes in contact pinned, those off the track free, the pusher
   /// on, set up again (factor or multigrid) only when the set of nodes off the track has changed. Null
   /// if that set leaves the slider free to move (every node lifted, say): then the dynamics go on.
-  StaticSolver* pinnedSolver();
-  /// The loading solve's solver, which held `fixed_dofs`, and the model's anchor stiffness then (N/m per
-  /// dof). The first pinned solver is made from it if it pins the same degrees of freedom: it differs by
-  /// the springs the pusher added (StaticSolver::withAddedSprings), and a second factorisation is spared.
-  void offerLoadingSolver(std::unique_ptr<StaticSolver> solver, std::vector<int> fixed_dofs, Vector anchor_stiffness);
+  StaticSolver* pinnedSolver() { return pinnedSolver(nullptr); }
+  /// The loading solve's solver, what it held and the model's anchor stiffness then.
+  struct LoadingSolve {
+    std::unique_ptr<StaticSolver> solver;
+    std::vector<int> fixed_dofs;
+    Vector anchor_stiffness;  ///< N/m per dof
+  };
+  /// pinnedSolver() at the loaded equilibrium, made from `loading` if it pins the same degrees of freedom:
+  /// the two differ by the springs the pusher added (StaticSolver::withAddedSprings), and a second
+  /// factorisation is spared. `loading` is spent either way.
+  StaticSolver* pinnedSolverAfterLoading(LoadingSolve loading) { return pinnedSolver(&loading); }
 
   long long jumps() const { return jumps_; }
   double jumpedTime() const { return jumped_time_; }  ///< s
 
  private:
+  /// pinnedSolver(), made from `loading` (if not null) when it is set up.
+  StaticSolver* pinnedSolver(LoadingSolve* loading);
   /// Where a jump along the equilibrium goes and how far.
   struct Path {
     Vector along;         ///< du/dX_s along the equilibrium
@@ -130,12 +138,9 @@ class FastForward {
 
   Simulation& sim_;
   QuasiStaticCreep creep_;
-  double next_creep_resume_ = 0.0;                ///< s, creepResumeDue's next time
-  std::unique_ptr<StaticSolver> pinned_solver_;   ///< see pinnedSolver(); null when its stiffness is singular
-  std::unique_ptr<StaticSolver> loading_solver_;  ///< see offerLoadingSolver(); null once used
-  std::vector<int> loading_fixed_dofs_;
-  Vector loading_anchor_stiffness_;  ///< N/m per dof
-  std::vector<int> lifted_nodes_;    ///< the interface nodes off the track it was set up for
+  double next_creep_resume_ = 0.0;               ///< s, creepResumeDue's next time
+  std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
+  std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
   /// du/dX_s (m/m), the slope of the path: first the free nodes' linear response to the stage, solved once
   /// per solver (the models' pushers are linear springs, whose force is affine in the stage's position);
   /// then the secant of each jump between equilibria long enough (kSecantPrecision): the springs' geometry

@@ -56,18 +56,17 @@ void Simulation::relaxToLoadedEquilibrium() {
   } else {
     model_->disconnectPusher();
   }
-  std::vector<int> held_while_loading = model_->blockedDofsDuringLoading();
-  auto loading = std::make_unique<StaticSolver>(*model_, held_while_loading, true);
-  loading->solve(*model_, u_, 0.0, body_force);
-  const Vector loading_anchor_stiffness = model_->anchorStiffness();
+  FastForward::LoadingSolve loading{nullptr, model_->blockedDofsDuringLoading(), Vector()};
+  loading.solver = std::make_unique<StaticSolver>(*model_, loading.fixed_dofs, true);
+  loading.solver->solve(*model_, u_, 0.0, body_force);
+  loading.anchor_stiffness = model_->anchorStiffness();
   if (!prestressed) model_->connectPusher(u_);
   contact_.reset(u_);
   power_ = acceleration(u_, v_, 0.0, a_);
   if (contact_.updateStates(u_, v_, 0.0, node_mass_)) reapplyFriction();
   ledger_.start(model_->elasticEnergy(u_, stage_.position()) + contact_.anchorEnergy(u_), u_);
   if (scene_.integrator.fast_forward) {
-    fast_forward_->offerLoadingSolver(std::move(loading), std::move(held_while_loading), loading_anchor_stiffness);
-    const bool pinned = fast_forward_->pinnedSolver() != nullptr;  // uses the offer now, or frees it
+    const bool pinned = fast_forward_->pinnedSolverAfterLoading(std::move(loading)) != nullptr;
     fast_forward_->setQuasiStatic(contact_.slidingCount() == 0 && pinned);
   }
 }
