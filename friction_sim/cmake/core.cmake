@@ -8,7 +8,7 @@ find_package(OpenMP REQUIRED COMPONENTS CXX)
 # large lattices within memory (Eigen's simplicial LDLT needed > 3 GB at 10^6 nodes).
 find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
 find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
-# Eigen's and CHOLMOD's headers for every target from here on (the public static_solver.h includes both).
+# Eigen's and CHOLMOD's headers for every target from here on (the core's solvers and their tests use both).
 include_directories(SYSTEM ${EIGEN3_INCLUDE_DIR} ${CHOLMOD_INCLUDE_DIR})
 
 add_library(friction_sim_core
@@ -33,6 +33,7 @@ add_library(friction_sim_core
   src/core/scene/loading_protocol.cpp
   src/core/scene/scene_io.cpp
   src/core/scene/scene_validation.cpp
+  src/core/solvers/cholesky_factor.cpp
   src/core/solvers/grid_multigrid.cpp
   src/core/solvers/integrator.cpp
   src/core/solvers/static_solver.cpp
@@ -64,6 +65,7 @@ target_link_libraries(friction_run friction_sim_core)
 # The core's unit tests (GoogleTest), run by catkin or by CTest.
 set(FRICTION_SIM_CORE_TESTS
   test/test_analysis.cpp
+  test/test_cholesky_factor.cpp
   test/test_closed_forms.cpp
   test/test_determinism.cpp
   test/test_run_driver.cpp
@@ -77,6 +79,8 @@ set(FRICTION_SIM_CORE_TESTS
   test/test_strips.cpp
   test/test_runs.cpp
 )
+# The core's tests reach its own headers too (src/core/<room>/).
+set(FRICTION_SIM_CORE_TEST_INCLUDES "${CMAKE_CURRENT_SOURCE_DIR}/src/core")
 # Where the core's tests find the shipped scenes and the pinned results.
 set(FRICTION_SIM_CORE_TEST_DEFINITIONS
   SCENE_DIR="${CMAKE_CURRENT_SOURCE_DIR}/scenes"

@@ -1,12 +1,12 @@
 // Static equilibrium of the slider with some degrees of freedom held fixed, by modified Newton: the
 // linearised stiffness of the free degrees of freedom is factored once (CHOLMOD's simplicial Cholesky) and
-// corrects the residual of the full (geometric, one-sided) forces until they balance. Used for the
+// corrects the residual of the full (geometric, one-sided) forces until they balance (through the factor
+// rounded to single precision: the residual, in double, sets the equilibrium). Used for the
 // loading protocol and, with the interface pinned, for the quasi-static fast-forward. A lattice too
 // large for the factor's memory is solved by multigrid-preconditioned conjugate gradients instead.
 #pragma once
 
 #include <Eigen/Cholesky>
-#include <Eigen/CholmodSupport>
 #include <memory>
 #include <vector>
 
@@ -14,6 +14,7 @@
 
 namespace friction {
 
+class CholeskyFactor;
 class GridMultigrid;
 
 /// How the linearised stiffness is inverted.
@@ -74,16 +75,15 @@ class StaticSolver {
   int multigridIterations() const;
 
  private:
-  /// response() on the free degrees of freedom alone.
-  Vector reducedResponse(const Vector& reduced) const;
+  /// response() on the free degrees of freedom alone; `single_precision` solves through the factor
+  /// rounded to single precision (the direct method only; see CholeskyFactor).
+  Vector reducedResponse(const Vector& reduced, bool single_precision = false) const;
+  /// response(), through the single-precision factor if `single_precision`.
+  Vector response(const Vector& force, bool single_precision) const;
 
   std::vector<int> free_dofs_;
-  /// Simplicial rather than supernodal: with the reference BLAS the supernodal factor's dense blocks gain
-  /// nothing, and its OpenMP regions (four threads, fixed when CHOLMOD is built) cost thread wake-ups.
-  /// Simplicial factors 2.4, 2.0 and 1.2× as fast and solves 2.2, 1.3 and 1.45× as fast at 113 × 61,
-  /// 225 × 121 and 449 × 241 (2026-11-27, AMD EPYC Zen 1, Debian's CHOLMOD 3.0.14).
-  std::unique_ptr<Eigen::CholmodSimplicialLLT<SparseMatrix>> factor_;  ///< the direct method's
-  std::unique_ptr<GridMultigrid> multigrid_;                           ///< or the iterative one's
+  std::unique_ptr<CholeskyFactor> factor_;    ///< the direct method's
+  std::unique_ptr<GridMultigrid> multigrid_;  ///< or the iterative one's
   /// Springs added by withAddedSprings: their positions among the free degrees of freedom, the factored
   /// matrix's response to a unit force at each (one column each), and the Cholesky factor of the
   /// capacitance matrix diag(1/k) + (those responses at those positions).

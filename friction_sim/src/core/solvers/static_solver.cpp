@@ -1,5 +1,6 @@
 #include "friction_sim/solvers/static_solver.h"
 
+#include "solvers/cholesky_factor.h"
 #include "solvers/grid_multigrid.h"
 
 #include <algorithm>
@@ -84,25 +85,26 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
     return;
   }
   const SparseMatrix reduced = freeStiffness(model, lifted_nodes, position_in_free, free_count, true);
-  factor_ = std::make_unique<Eigen::CholmodSimplicialLLT<SparseMatrix>>(reduced);
-  if (factor_->info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
+  factor_ = std::make_unique<CholeskyFactor>(reduced);
 }
 
-Vector StaticSolver::response(const Vector& force) const {
+Vector StaticSolver::response(const Vector& force) const { return response(force, false); }
+
+Vector StaticSolver::response(const Vector& force, bool single_precision) const {
   Vector reduced(free_dofs_.size());
   for (std::size_t i = 0; i < free_dofs_.size(); ++i) reduced[i] = force[free_dofs_[i]];
-  const Vector solution = reducedResponse(reduced);
+  const Vector solution = reducedResponse(reduced, single_precision);
   Vector out = Vector::Zero(force.size());
   for (std::size_t i = 0; i < free_dofs_.size(); ++i) out[free_dofs_[i]] = solution[i];
   return out;
 }
 
-Vector StaticSolver::reducedResponse(const Vector& reduced) const {
+Vector StaticSolver::reducedResponse(const Vector& reduced, bool single_precision) const {
   Vector solution;
   if (multigrid_) {
     solution = multigrid_->solve(reduced, kMultigridTolerance);
   } else if (factor_) {
-    solution = factor_->solve(reduced);
+    solution = single_precision ? factor_->solveSinglePrecision(reduced) : factor_->solve(reduced);
   } else {
     solution = reduced;  // no free degree of freedom
   }
@@ -153,7 +155,7 @@ double StaticSolver::correct(const Model& model, Vector& u, double stage_positio
   ForceEvaluation evaluation;
   model.evaluate(u, Vector::Zero(u.size()), stage_position, evaluation);
   if (body_force.size() > 0) evaluation.force += body_force;
-  const Vector correction = response(evaluation.force);
+  const Vector correction = response(evaluation.force, true);
   u += correction;
   return correction.lpNorm<Eigen::Infinity>();
 }

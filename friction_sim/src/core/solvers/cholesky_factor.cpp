@@ -1,0 +1,128 @@
+#include "solvers/cholesky_factor.h"
+
+#include <algorithm>
+#include <numeric>
+#include <type_traits>
+#include <stdexcept>
+
+namespace friction {
+
+namespace {
+/// Calls `body` with std::integral_constant<int, width> for the narrow supernodes, which are nearly all,
+/// so that their loops over columns are unrolled, and with std::integral_constant<int, 0> otherwise.
+template <typename Body>
+void forEachWidth(int width, Body&& body) {
+  switch (width) {
+    case 1: return body(std::integral_constant<int, 1>());
+    case 2: return body(std::integral_constant<int, 2>());
+    case 3: return body(std::integral_constant<int, 3>());
+    case 4: return body(std::integral_constant<int, 4>());
+    case 5: return body(std::integral_constant<int, 5>());
+    case 6: return body(std::integral_constant<int, 6>());
+    case 7: return body(std::integral_constant<int, 7>());
+    case 8: return body(std::integral_constant<int, 8>());
+    default: return body(std::integral_constant<int, 0>());
+  }
+}
+}  // namespace
+
+CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) : cholmod_(lower) {
+  if (cholmod_.info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
+  const cholmod_factor& factor = cholmod_.factor();
+  if (factor.is_super || !factor.is_ll || factor.xtype != CHOLMOD_REAL || factor.itype != CHOLMOD_INT) {
+    throw std::logic_error("CholeskyFactor: CHOLMOD did not give a simplicial real LLᵀ factor with int indices");
+  }
+  const int n = static_cast<int>(factor.n);
+  const int* perm = static_cast<const int*>(factor.Perm);
+  fill_order_.resize(n);
+  if (perm) {
+    fill_order_.assign(perm, perm + n);
+  } else {
+    std::iota(fill_order_.begin(), fill_order_.end(), 0);
+  }
+  // A simplicial factor's columns need not be packed: column j holds nz[j] entries from p[j], the
+  // diagonal first, its rows ascending.
+  const int* start = static_cast<const int*>(factor.p);
+  const int* count = static_cast<const int*>(factor.nz);
+  const int* row = static_cast<const int*>(factor.i);
+  const double* value = static_cast<const double*>(factor.x);
+  // Column j + 1 continues column j's supernode when its pattern is column j's without row j + 1.
+  const auto continues = [&](int j) {
+    return count[j + 1] == count[j] - 1 && count[j] > 1 && row[start[j] + 1] == j + 1 &&
+           std::equal(row + start[j] + 2, row + start[j] + count[j], row + start[j + 1] + 1);
+  };
+  first_column_ = {0};
+  diagonal_start_ = {0};
+  rows_start_ = {0};
+  below_start_ = {0};
+  for (int first = 0; first < n;) {
+    int width = 1;
+    while (first + width < n && width < kWidestSupernode && continues(first + width - 1)) ++width;
+    const int below_count = count[first] - width;
+    for (int c = 0; c < width; ++c) {
+      const int column = start[first + c];
+      for (int r = 0; r < width; ++r) diagonal_.push_back(r < c ? 0.0 : value[column + r - c]);
+    }
+    rows_.insert(rows_.end(), row + start[first] + width, row + start[first] + count[first]);
+    for (int r = 0; r < below_count; ++r) {
+      for (int c = 0; c < width; ++c) below_.push_back(static_cast<float>(value[start[first + c] + width - c + r]));
+    }
+    first += width;
+    first_column_.push_back(first);
+    diagonal_start_.push_back(static_cast<int>(diagonal_.size()));
+    rows_start_.push_back(static_cast<int>(rows_.size()));
+    below_start_.push_back(static_cast<long>(below_.size()));
+  }
+}
+
+Vector CholeskyFactor::solve(const Vector& rhs) const { return cholmod_.solve(rhs); }
+
+Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
+  const int n = static_cast<int>(fill_order_.size());
+  Vector y(n);
+  for (int k = 0; k < n; ++k) y[k] = rhs[fill_order_[k]];
+  const int supernodes = static_cast<int>(first_column_.size()) - 1;
+  // One supernode's part of y, kept apart: the compiler cannot tell it from the rows below it.
+  double part[kWidestSupernode];
+  for (int s = 0; s < supernodes; ++s) {  // L·y = P·rhs
+    const int first = first_column_[s], width = first_column_[s + 1] - first;
+    const double* diagonal = &diagonal_[diagonal_start_[s]];
+    for (int c = 0; c < width; ++c) part[c] = y[first + c];
+    for (int c = 0; c < width; ++c) {
+      const double yc = (part[c] /= diagonal[c * width + c]);
+      for (int r = c + 1; r < width; ++r) part[r] -= diagonal[c * width + r] * yc;
+      y[first + c] = yc;
+    }
+    forEachWidth(width, [&](auto fixed_width) {
+      const int w = decltype(fixed_width)::value > 0 ? decltype(fixed_width)::value : width;
+      const float* below = &below_[below_start_[s]];
+      for (int r = rows_start_[s]; r < rows_start_[s + 1]; ++r, below += w) {
+        double sum = 0.0;
+        for (int c = 0; c < w; ++c) sum += below[c] * part[c];
+        y[rows_[r]] -= sum;
+      }
+    });
+  }
+  for (int s = supernodes - 1; s >= 0; --s) {  // Lᵀ·z = y
+    const int first = first_column_[s], width = first_column_[s + 1] - first;
+    for (int c = 0; c < width; ++c) part[c] = y[first + c];
+    forEachWidth(width, [&](auto fixed_width) {
+      const int w = decltype(fixed_width)::value > 0 ? decltype(fixed_width)::value : width;
+      const float* below = &below_[below_start_[s]];
+      for (int r = rows_start_[s]; r < rows_start_[s + 1]; ++r, below += w) {
+        const double yr = y[rows_[r]];
+        for (int c = 0; c < w; ++c) part[c] -= below[c] * yr;
+      }
+    });
+    const double* diagonal = &diagonal_[diagonal_start_[s]];
+    for (int c = width - 1; c >= 0; --c) {
+      for (int r = c + 1; r < width; ++r) part[c] -= diagonal[c * width + r] * part[r];
+      y[first + c] = part[c] /= diagonal[c * width + c];
+    }
+  }
+  Vector solution(n);
+  for (int k = 0; k < n; ++k) solution[fill_order_[k]] = y[k];
+  return solution;
+}
+
+}  // namespace friction

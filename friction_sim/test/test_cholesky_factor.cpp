@@ -1,0 +1,75 @@
+// The direct method's factor: CHOLMOD's solve in double, and the single-precision copy in supernodes
+// that the modified-Newton corrections use.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "solvers/cholesky_factor.h"
+
+namespace friction {
+namespace {
+
+/// The lower triangle of a symmetric matrix given by its entries on and below the diagonal.
+SparseMatrix lowerOf(int size, const std::vector<Eigen::Triplet<double>>& entries) {
+  SparseMatrix lower(size, size);
+  lower.setFromTriplets(entries.begin(), entries.end());
+  return lower;
+}
+
+/// The five-point Laplacian of an n × n grid plus `shift` on the diagonal: under AMD its factor has
+/// supernodes of every width from one column to the separators' tens.
+SparseMatrix gridLaplacian(int n, double shift) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const int node = j * n + i;
+      entries.emplace_back(node, node, 4.0 + shift);
+      if (i + 1 < n) entries.emplace_back(node + 1, node, -1.0);
+      if (j + 1 < n) entries.emplace_back(node + n, node, -1.0);
+    }
+  }
+  return lowerOf(n * n, entries);
+}
+
+/// A dense symmetric positive definite matrix: one supernode wider than a solve takes at once.
+SparseMatrix denseMatrix(int n) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int c = 0; c < n; ++c) {
+    for (int r = c; r < n; ++r) entries.emplace_back(r, c, r == c ? 2.0 * n : 1.0 / (1.0 + r - c));
+  }
+  return lowerOf(n, entries);
+}
+
+/// A tridiagonal matrix: every supernode one column wide.
+SparseMatrix tridiagonal(int n) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < n; ++i) {
+    entries.emplace_back(i, i, 2.5);
+    if (i + 1 < n) entries.emplace_back(i + 1, i, -1.0);
+  }
+  return lowerOf(n, entries);
+}
+
+TEST(CholeskyFactor, SinglePrecisionSolveMatchesTheDoubleSolve) {
+  for (const SparseMatrix& lower : {gridLaplacian(70, 1e-3), denseMatrix(45), tridiagonal(500)}) {
+    const CholeskyFactor factor(lower);
+    const SparseMatrix matrix = lower.selfadjointView<Eigen::Lower>();
+    std::srand(7);
+    const Vector rhs = Vector::Random(lower.rows());
+    const Vector exact = factor.solve(rhs);
+    const Vector single = factor.solveSinglePrecision(rhs);
+    EXPECT_LT((matrix * exact - rhs).norm(), 1e-12 * rhs.norm()) << lower.rows();
+    // Entries rounded to float (6·10⁻⁸), sums in double: the error stays near the rounding's.
+    EXPECT_LT((single - exact).norm(), 1e-6 * exact.norm()) << lower.rows();
+    EXPECT_GT((single - exact).norm(), 0.0) << lower.rows();  // it is the single-precision copy
+  }
+}
+
+TEST(CholeskyFactor, RefusesASingularMatrix) {
+  // A zero row and column: not positive definite.
+  std::vector<Eigen::Triplet<double>> entries = {{0, 0, 1.0}, {2, 2, 1.0}};
+  EXPECT_THROW(CholeskyFactor(lowerOf(3, entries)), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace friction
