@@ -197,12 +197,23 @@ TEST(FastForward, GoesOnWithTheTrailingEdgeLiftedAndAgreesWithFullDynamics) {
   scene.integrator.fast_forward = true;
   Simulation fast(scene);
   long long jumps_with_a_node_lifted = 0;
+  std::vector<char> lifted(fast.contact().size(), 0);
+  int lifted_set_changes = 0;
   while (!fast.finished()) {
     const long long jumps = fast.jumps();
     fast.advance(scene.stop.time);
     if (fast.jumps() > jumps && fast.contact().detachedCount() > 0) ++jumps_with_a_node_lifted;
+    std::vector<char> now(lifted.size());
+    for (int node = 0; node < fast.contact().size(); ++node) {
+      now[node] = fast.contact().state(node) == ContactState::Detached;
+    }
+    if (now != lifted) ++lifted_set_changes;
+    lifted.swap(now);
   }
   EXPECT_GT(jumps_with_a_node_lifted, 5);
+  // The corner lifts and lands again: a contact set that comes back reuses the solver kept for it.
+  // Measured: 5 set-ups for 8 changes seen between advances (5 sets).
+  EXPECT_LT(fast.staticSolverSetups(), lifted_set_changes);
   EXPECT_LT(fast.steps(), full.steps() / 10);
   auto extended = [](const std::vector<SlipEvent>& events) {
     std::vector<SlipEvent> out;

@@ -73,6 +73,8 @@ class StaticSolver {
   double tolerance() const { return tolerance_; }
   /// Conjugate-gradient iterations of the last multigrid solve (0 with the direct method).
   int multigridIterations() const;
+  /// Bytes the direct method's factor holds; 0 with multigrid.
+  std::size_t directFactorBytes() const;
 
  private:
   /// response() on the free degrees of freedom alone; `single_precision` solves through the factor

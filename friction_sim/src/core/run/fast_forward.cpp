@@ -27,22 +27,31 @@ StaticSolver* FastForward::pinnedSolver(LoadingSolve* loading) {
     if (contact.state(node) == ContactState::Detached) lifted.push_back(node);
   }
   if (lifted != lifted_nodes_ || (lifted_nodes_.empty() && !pinned_solver_)) {
-    pinned_solver_.reset();  // first: at 10⁶ nodes two solvers would not fit the memory budget
     creep_.forget();
+    std::unique_ptr<StaticSolver> solver;
+    if (spare_solver_ && spare_lifted_nodes_ == lifted) solver = std::move(spare_solver_);
+    // Free what is not kept before a factorisation: at 10⁶ nodes two solvers would not fit the memory budget.
+    spare_solver_.reset();
+    const std::size_t factor_bytes = pinned_solver_ ? pinned_solver_->directFactorBytes() : 0;
+    if (factor_bytes > 0 && factor_bytes <= kLargestSpareFactor) {
+      spare_solver_ = std::move(pinned_solver_);
+      spare_lifted_nodes_ = lifted_nodes_;
+    }
+    pinned_solver_.reset();
     lifted_nodes_.swap(lifted);
     std::vector<int> in_contact;
     for (int node = 0; node < contact.size(); ++node) {
       if (contact.state(node) != ContactState::Detached) in_contact.push_back(contact.dofs()[node]);
     }
     try {
-      std::unique_ptr<StaticSolver> solver;
-      if (loading && loading->solver && lifted_nodes_.empty() && in_contact == loading->fixed_dofs) {
+      if (!solver && loading && loading->solver && lifted_nodes_.empty() && in_contact == loading->fixed_dofs) {
         solver = StaticSolver::withAddedSprings(std::move(loading->solver),
                                                 sim_.model_->anchorStiffness() - loading->anchor_stiffness);
       }
       if (loading) loading->solver.reset();  // first, as above
       if (!solver) {
         solver = std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
+        ++solver_setups_;
       }
       // The pusher's force is affine in the stage's position: one solve gives the response to it, the
       // path's slope until a jump's secant takes its place.

@@ -55,6 +55,8 @@ class FastForward {
   StaticSolver* pinnedSolverAfterLoading(LoadingSolve loading) { return pinnedSolver(&loading); }
 
   long long jumps() const { return jumps_; }
+  /// Pinned solvers set up (factorisations, but for the one made from the loading solve).
+  long long solverSetups() const { return solver_setups_; }
   double jumpedTime() const { return jumped_time_; }  ///< s
 
  private:
@@ -141,6 +143,13 @@ class FastForward {
   double next_creep_resume_ = 0.0;               ///< s, creepResumeDue's next time
   std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
   std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
+  /// The solver before, kept for when its contact set comes back: a corner that lifts and lands again
+  /// toggles between two sets (449 × 241: 15 factorisations of 4 s to the first global event, all but two
+  /// of them repeats). Kept up to kLargestSpareFactor bytes; never a multigrid solver.
+  std::unique_ptr<StaticSolver> spare_solver_;
+  std::vector<int> spare_lifted_nodes_;
+  static constexpr std::size_t kLargestSpareFactor = std::size_t(1) << 29;  // 512 MiB
+  long long solver_setups_ = 0;
   /// du/dX_s (m/m), the slope of the path: first the free nodes' linear response to the stage, solved once
   /// per solver (the models' pushers are linear springs, whose force is affine in the stage's position);
   /// then the secant of each jump between equilibria long enough (kSecantPrecision): the springs' geometry

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <numeric>
-#include <type_traits>
 #include <stdexcept>
+#include <type_traits>
 
 namespace friction {
 
@@ -13,15 +13,24 @@ namespace {
 template <typename Body>
 void forEachWidth(int width, Body&& body) {
   switch (width) {
-    case 1: return body(std::integral_constant<int, 1>());
-    case 2: return body(std::integral_constant<int, 2>());
-    case 3: return body(std::integral_constant<int, 3>());
-    case 4: return body(std::integral_constant<int, 4>());
-    case 5: return body(std::integral_constant<int, 5>());
-    case 6: return body(std::integral_constant<int, 6>());
-    case 7: return body(std::integral_constant<int, 7>());
-    case 8: return body(std::integral_constant<int, 8>());
-    default: return body(std::integral_constant<int, 0>());
+    case 1:
+      return body(std::integral_constant<int, 1>());
+    case 2:
+      return body(std::integral_constant<int, 2>());
+    case 3:
+      return body(std::integral_constant<int, 3>());
+    case 4:
+      return body(std::integral_constant<int, 4>());
+    case 5:
+      return body(std::integral_constant<int, 5>());
+    case 6:
+      return body(std::integral_constant<int, 6>());
+    case 7:
+      return body(std::integral_constant<int, 7>());
+    case 8:
+      return body(std::integral_constant<int, 8>());
+    default:
+      return body(std::integral_constant<int, 0>());
   }
 }
 }  // namespace
@@ -80,6 +89,12 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) : cholmod_(lower) {
 }
 
 Vector CholeskyFactor::solve(const Vector& rhs) const { return cholmod_.solve(rhs); }
+
+std::size_t CholeskyFactor::bytes() const {
+  return cholmod_.factor().nzmax * (sizeof(double) + sizeof(int)) + fill_order_.size() * sizeof(int) +
+         (first_column_.size() + diagonal_start_.size() + rows_start_.size() + rows_.size()) * sizeof(int) +
+         below_start_.size() * sizeof(long) + diagonal_.size() * sizeof(double) + below_.size() * sizeof(float);
+}
 
 Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
   const int n = static_cast<int>(fill_order_.size());

@@ -24,6 +24,9 @@ class CholeskyFactor {
   /// and a modified-Newton loop, whose residual is evaluated in double, converges to the same equilibrium.
   Vector solveSinglePrecision(const Vector& rhs) const;
 
+  /// Bytes held: CHOLMOD's factor and the single-precision copy.
+  std::size_t bytes() const;
+
  private:
   /// Columns per supernode at most (a solve keeps one supernode's partial sums on the stack).
   static constexpr int kWidestSupernode = 32;

@@ -185,4 +185,6 @@ StaticSolver::~StaticSolver() = default;
 
 int StaticSolver::multigridIterations() const { return multigrid_ ? multigrid_->lastIterations() : 0; }
 
+std::size_t StaticSolver::directFactorBytes() const { return factor_ ? factor_->bytes() : 0; }
+
 }  // namespace friction
