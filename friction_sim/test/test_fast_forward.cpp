@@ -197,23 +197,12 @@ TEST(FastForward, GoesOnWithTheTrailingEdgeLiftedAndAgreesWithFullDynamics) {
   scene.integrator.fast_forward = true;
   Simulation fast(scene);
   long long jumps_with_a_node_lifted = 0;
-  std::vector<char> lifted(fast.contact().size(), 0);
-  int lifted_set_changes = 0;
   while (!fast.finished()) {
     const long long jumps = fast.jumps();
     fast.advance(scene.stop.time);
     if (fast.jumps() > jumps && fast.contact().detachedCount() > 0) ++jumps_with_a_node_lifted;
-    std::vector<char> now(lifted.size());
-    for (int node = 0; node < fast.contact().size(); ++node) {
-      now[node] = fast.contact().state(node) == ContactState::Detached;
-    }
-    if (now != lifted) ++lifted_set_changes;
-    lifted.swap(now);
   }
   EXPECT_GT(jumps_with_a_node_lifted, 5);
-  // The corner lifts and lands again: a contact set that comes back reuses the solver kept for it.
-  // Measured: 5 set-ups for 8 changes seen between advances (5 sets).
-  EXPECT_LT(fast.staticSolverSetups(), lifted_set_changes);
   EXPECT_LT(fast.steps(), full.steps() / 10);
   auto extended = [](const std::vector<SlipEvent>& events) {
     std::vector<SlipEvent> out;
@@ -231,6 +220,23 @@ TEST(FastForward, GoesOnWithTheTrailingEdgeLiftedAndAgreesWithFullDynamics) {
                 2e-3 * full_events[e].onset_shear_force);
   }
   EXPECT_TRUE(fast_events.back().global);
+  EXPECT_LT(std::abs(fast.energy().relativeResidual()), 5e-4);
+}
+
+TEST(FastForward, TakesBackTheSolverOfAContactSetThatReturns) {
+  // Pressed lightly and pushed at the top, the trailing corner lifts and lands again after each global
+  // event; the solver kept for the set before spares a factorisation each time that set returns.
+  // Measured: 5 solvers set up, 3 taken back.
+  Scene scene = testing::coarseSliderScene(false);
+  scene.pusher.height = 0.075;
+  scene.load.normal_force = 100.0;
+  scene.stop.global_events = 3;
+  scene.integrator.fast_forward = true;
+  Simulation fast(scene);
+  fast.run();
+  EXPECT_EQ(fast.globalEventCount(), 3);
+  EXPECT_GT(fast.staticSolverReuses(), 0);
+  EXPECT_GT(fast.staticSolverSetups(), 0);
   EXPECT_LT(std::abs(fast.energy().relativeResidual()), 5e-4);
 }
 

@@ -62,8 +62,10 @@ class Simulation : public Dynamics {
   /// Fast-forward jumps taken, and simulated time (s) they covered.
   long long jumps() const;
   double jumpedTime() const;
-  /// Fast-forward's static solvers set up after the loading (factorisations of a new contact set).
+  /// Fast-forward's static solvers set up after the loading (factorisations of a new contact set), and
+  /// taken back for a contact set that returned.
   long long staticSolverSetups() const;
+  long long staticSolverReuses() const;
   /// True once the stop condition holds; `stopReason()` says which.
   bool finished() const { return !stop_reason_.empty(); }
   const std::string& stopReason() const { return stop_reason_; }

@@ -27,10 +27,14 @@ StaticSolver* FastForward::pinnedSolver(LoadingSolve* loading) {
     if (contact.state(node) == ContactState::Detached) lifted.push_back(node);
   }
   if (lifted != lifted_nodes_ || (lifted_nodes_.empty() && !pinned_solver_)) {
-    creep_.forget();
+    creep_.forget();  // it knows its solver by address, which a solver taken back from the spare reuses
     std::unique_ptr<StaticSolver> solver;
-    if (spare_solver_ && spare_lifted_nodes_ == lifted) solver = std::move(spare_solver_);
-    // Free what is not kept before a factorisation: at 10⁶ nodes two solvers would not fit the memory budget.
+    if (spare_solver_ && spare_lifted_nodes_ == lifted) {
+      solver = std::move(spare_solver_);
+      ++solver_reuses_;
+    }
+    // Free what is not kept before a factorisation. Multigrid solvers (10⁶ nodes) are never kept: two
+    // would not fit the memory budget.
     spare_solver_.reset();
     const std::size_t factor_bytes = pinned_solver_ ? pinned_solver_->directFactorBytes() : 0;
     if (factor_bytes > 0 && factor_bytes <= kLargestSpareFactor) {

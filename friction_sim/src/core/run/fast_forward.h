@@ -40,7 +40,8 @@ class FastForward {
   /// An event started or the stage moved too fast: off the static path until it is found again.
   void leavePath() { quasi_static_ = approaching_threshold_ = false; }
   /// The static solver with the interface nodes in contact pinned, those off the track free, the pusher
-  /// on, set up again (factor or multigrid) only when the set of nodes off the track has changed. Null
+  /// on, set up again (factor or multigrid) only when the set of nodes off the track has changed, and not
+  /// even then if it is the set before, whose solver is kept (spare_solver_). Null
   /// if that set leaves the slider free to move (every node lifted, say): then the dynamics go on.
   StaticSolver* pinnedSolver() { return pinnedSolver(nullptr); }
   /// The loading solve's solver, what it held and the model's anchor stiffness then.
@@ -55,8 +56,10 @@ class FastForward {
   StaticSolver* pinnedSolverAfterLoading(LoadingSolve loading) { return pinnedSolver(&loading); }
 
   long long jumps() const { return jumps_; }
-  /// Pinned solvers set up (factorisations, but for the one made from the loading solve).
+  /// Pinned solvers set up (factorisations, but for the one made from the loading solve), and taken back
+  /// from the spare.
   long long solverSetups() const { return solver_setups_; }
+  long long solverReuses() const { return solver_reuses_; }
   double jumpedTime() const { return jumped_time_; }  ///< s
 
  private:
@@ -150,6 +153,7 @@ class FastForward {
   std::vector<int> spare_lifted_nodes_;
   static constexpr std::size_t kLargestSpareFactor = std::size_t(1) << 29;  // 512 MiB
   long long solver_setups_ = 0;
+  long long solver_reuses_ = 0;
   /// du/dX_s (m/m), the slope of the path: first the free nodes' linear response to the stage, solved once
   /// per solver (the models' pushers are linear springs, whose force is affine in the stage's position);
   /// then the secant of each jump between equilibria long enough (kSecantPrecision): the springs' geometry

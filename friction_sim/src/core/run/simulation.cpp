@@ -83,6 +83,7 @@ bool Simulation::mayJump() const { return fast_forward_->mayJump(); }
 long long Simulation::jumps() const { return fast_forward_->jumps(); }
 double Simulation::jumpedTime() const { return fast_forward_->jumpedTime(); }
 long long Simulation::staticSolverSetups() const { return fast_forward_->solverSetups(); }
+long long Simulation::staticSolverReuses() const { return fast_forward_->solverReuses(); }
 
 void Simulation::advance(double until, double group_before) {
   if (mayJump() && fast_forward_->jump(until)) return;

@@ -33,6 +33,12 @@ void forEachWidth(int width, Body&& body) {
       return body(std::integral_constant<int, 0>());
   }
 }
+
+/// The width forEachWidth's body works with: the fixed one, or `width` where none is fixed.
+template <typename FixedWidth>
+int widthOf(FixedWidth, int width) {
+  return FixedWidth::value > 0 ? FixedWidth::value : width;
+}
 }  // namespace
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) : cholmod_(lower) {
@@ -43,10 +49,10 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) : cholmod_(lower) {
   }
   const int n = static_cast<int>(factor.n);
   const int* perm = static_cast<const int*>(factor.Perm);
-  fill_order_.resize(n);
   if (perm) {
     fill_order_.assign(perm, perm + n);
-  } else {
+  } else {  // the natural ordering
+    fill_order_.resize(n);
     std::iota(fill_order_.begin(), fill_order_.end(), 0);
   }
   // A simplicial factor's columns need not be packed: column j holds nz[j] entries from p[j], the
@@ -55,15 +61,12 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) : cholmod_(lower) {
   const int* count = static_cast<const int*>(factor.nz);
   const int* row = static_cast<const int*>(factor.i);
   const double* value = static_cast<const double*>(factor.x);
-  // Column j + 1 continues column j's supernode when its pattern is column j's without row j + 1.
+  // Column j + 1 continues column j's supernode when its pattern below the diagonal is column j's
+  // without row j + 1.
   const auto continues = [&](int j) {
     return count[j + 1] == count[j] - 1 && count[j] > 1 && row[start[j] + 1] == j + 1 &&
            std::equal(row + start[j] + 2, row + start[j] + count[j], row + start[j + 1] + 1);
   };
-  // Reserved at once: growing by doubling would hold up to twice the copy at 10⁵ nodes (hundreds of MB).
-  const long entries = std::accumulate(count, count + n, 0L);
-  below_.reserve(entries - n);
-  rows_.reserve(entries - n);
   first_column_ = {0};
   diagonal_start_ = {0};
   rows_start_ = {0};
@@ -72,19 +75,27 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) : cholmod_(lower) {
     int width = 1;
     while (first + width < n && width < kWidestSupernode && continues(first + width - 1)) ++width;
     const int below_count = count[first] - width;
-    for (int c = 0; c < width; ++c) {
-      const int column = start[first + c];
-      for (int r = 0; r < width; ++r) diagonal_.push_back(r < c ? 0.0 : value[column + r - c]);
-    }
-    rows_.insert(rows_.end(), row + start[first] + width, row + start[first] + count[first]);
-    for (int r = 0; r < below_count; ++r) {
-      for (int c = 0; c < width; ++c) below_.push_back(static_cast<float>(value[start[first + c] + width - c + r]));
-    }
     first += width;
     first_column_.push_back(first);
-    diagonal_start_.push_back(static_cast<int>(diagonal_.size()));
-    rows_start_.push_back(static_cast<int>(rows_.size()));
-    below_start_.push_back(static_cast<long>(below_.size()));
+    diagonal_start_.push_back(diagonal_start_.back() + width * width);
+    rows_start_.push_back(rows_start_.back() + below_count);
+    below_start_.push_back(below_start_.back() + below_count * width);
+  }
+  // Sized at once: growing by doubling could hold twice the copy while it is made (hundreds of MB).
+  diagonal_.assign(diagonal_start_.back(), 0.0);
+  rows_.resize(rows_start_.back());
+  below_.resize(below_start_.back());
+  for (std::size_t s = 0; s + 1 < first_column_.size(); ++s) {
+    const int first = first_column_[s], width = first_column_[s + 1] - first;
+    for (int c = 0; c < width; ++c) {
+      const int column_start = start[first + c];
+      for (int r = c; r < width; ++r) diagonal_[diagonal_start_[s] + c * width + r] = value[column_start + r - c];
+    }
+    std::copy(row + start[first] + width, row + start[first] + count[first], rows_.begin() + rows_start_[s]);
+    float* below = &below_[below_start_[s]];
+    for (int r = 0; r < rows_start_[s + 1] - rows_start_[s]; ++r) {
+      for (int c = 0; c < width; ++c) *below++ = static_cast<float>(value[start[first + c] + width - c + r]);
+    }
   }
 }
 
@@ -92,8 +103,9 @@ Vector CholeskyFactor::solve(const Vector& rhs) const { return cholmod_.solve(rh
 
 std::size_t CholeskyFactor::bytes() const {
   return cholmod_.factor().nzmax * (sizeof(double) + sizeof(int)) + fill_order_.size() * sizeof(int) +
-         (first_column_.size() + diagonal_start_.size() + rows_start_.size() + rows_.size()) * sizeof(int) +
-         below_start_.size() * sizeof(long) + diagonal_.size() * sizeof(double) + below_.size() * sizeof(float);
+         (first_column_.size() + diagonal_start_.size() + rows_start_.size() + below_start_.size() + rows_.size()) *
+             sizeof(int) +
+         diagonal_.size() * sizeof(double) + below_.size() * sizeof(float);
 }
 
 Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
@@ -113,7 +125,7 @@ Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
       y[first + c] = yc;
     }
     forEachWidth(width, [&](auto fixed_width) {
-      const int w = decltype(fixed_width)::value > 0 ? decltype(fixed_width)::value : width;
+      const int w = widthOf(fixed_width, width);
       const float* below = &below_[below_start_[s]];
       for (int r = rows_start_[s]; r < rows_start_[s + 1]; ++r, below += w) {
         double sum = 0.0;
@@ -126,7 +138,7 @@ Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
     const int first = first_column_[s], width = first_column_[s + 1] - first;
     for (int c = 0; c < width; ++c) part[c] = y[first + c];
     forEachWidth(width, [&](auto fixed_width) {
-      const int w = decltype(fixed_width)::value > 0 ? decltype(fixed_width)::value : width;
+      const int w = widthOf(fixed_width, width);
       const float* below = &below_[below_start_[s]];
       for (int r = rows_start_[s]; r < rows_start_[s + 1]; ++r, below += w) {
         const double yr = y[rows_[r]];

@@ -56,7 +56,7 @@ class CholeskyFactor {
   /// from below_start_[s], in single precision.
   std::vector<int> rows_start_;
   std::vector<int> rows_;
-  std::vector<long> below_start_;
+  std::vector<int> below_start_;
   std::vector<float> below_;
 };
 

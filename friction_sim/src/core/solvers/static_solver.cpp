@@ -151,11 +151,16 @@ std::unique_ptr<StaticSolver> StaticSolver::withAddedSprings(std::unique_ptr<Sta
 }
 
 double StaticSolver::correct(const Model& model, Vector& u, double stage_position, const Vector& body_force) const {
+  return correct(model, u, stage_position, body_force, true);
+}
+
+double StaticSolver::correct(const Model& model, Vector& u, double stage_position, const Vector& body_force,
+                             bool single_precision) const {
   if (free_dofs_.empty()) return 0.0;
   ForceEvaluation evaluation;
   model.evaluate(u, Vector::Zero(u.size()), stage_position, evaluation);
   if (body_force.size() > 0) evaluation.force += body_force;
-  const Vector correction = response(evaluation.force, true);
+  const Vector correction = response(evaluation.force, single_precision);
   u += correction;
   return correction.lpNorm<Eigen::Infinity>();
 }
@@ -167,11 +172,15 @@ int StaticSolver::solve(Model& model, Vector& u, double stage_position, const Ve
   // whose only use would be to show a correction below the tolerance. The ratio is the larger of the
   // last two, and none is taken across a change of the top load (another problem).
   double last_correction = 0.0, last_ratio = kLargestTrustedRatio;
+  bool single_precision = true;
   for (int iteration = 1; iteration <= kMaxIterations; ++iteration) {
-    const double correction = correct(model, u, stage_position, body_force);
+    const double correction = correct(model, u, stage_position, body_force, single_precision);
     const bool load_changed = balance_load_ && model.rebalanceLoad(u);
-    const double ratio =
-        last_correction > 0.0 && std::isfinite(last_correction) ? correction / last_correction : kLargestTrustedRatio;
+    const bool measured = last_correction > 0.0 && std::isfinite(last_correction);
+    const double ratio = measured ? correction / last_correction : kLargestTrustedRatio;
+    // The single-precision factor's error (its condition number times about 6·10⁻⁸) would bound the
+    // contraction of an ill-conditioned stiffness: corrections that stop halving go on in double.
+    if (measured && ratio > kLargestTrustedRatio) single_precision = false;
     const double trusted = std::max(ratio, last_ratio);
     const double left = trusted < kLargestTrustedRatio ? correction * trusted / (1.0 - trusted) : correction;
     if (!load_changed && left < tolerance_) return iteration;
