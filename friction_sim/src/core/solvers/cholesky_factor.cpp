@@ -4,34 +4,25 @@
 #include <numeric>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 
 namespace friction {
 
 namespace {
-/// Calls `body` with std::integral_constant<int, width> for the narrow supernodes, which are nearly all,
-/// so that their loops over columns are unrolled, and with std::integral_constant<int, 0> otherwise.
+/// The widths whose loops over columns are unrolled: the narrow supernodes, which are nearly all.
+constexpr int kUnrolledWidths = 8;
+
+/// Calls `body` with std::integral_constant<int, width> for widths 1 to kUnrolledWidths, with
+/// std::integral_constant<int, 0> otherwise.
+template <typename Body, int... Widths>
+void forEachWidth(int width, Body&& body, std::integer_sequence<int, Widths...>) {
+  const bool unrolled = ((width == Widths + 1 && (body(std::integral_constant<int, Widths + 1>()), true)) || ...);
+  if (!unrolled) body(std::integral_constant<int, 0>());
+}
+
 template <typename Body>
 void forEachWidth(int width, Body&& body) {
-  switch (width) {
-    case 1:
-      return body(std::integral_constant<int, 1>());
-    case 2:
-      return body(std::integral_constant<int, 2>());
-    case 3:
-      return body(std::integral_constant<int, 3>());
-    case 4:
-      return body(std::integral_constant<int, 4>());
-    case 5:
-      return body(std::integral_constant<int, 5>());
-    case 6:
-      return body(std::integral_constant<int, 6>());
-    case 7:
-      return body(std::integral_constant<int, 7>());
-    case 8:
-      return body(std::integral_constant<int, 8>());
-    default:
-      return body(std::integral_constant<int, 0>());
-  }
+  forEachWidth(width, body, std::make_integer_sequence<int, kUnrolledWidths>());
 }
 
 /// The width forEachWidth's body works with: the fixed one, or `width` where none is fixed.
