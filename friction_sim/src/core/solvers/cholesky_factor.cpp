@@ -83,7 +83,7 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) : cholmod_(lower) {
       for (int r = c; r < width; ++r) diagonal_[diagonal_start_[s] + c * width + r] = value[column_start + r - c];
     }
     std::copy(row + start[first] + width, row + start[first] + count[first], rows_.begin() + rows_start_[s]);
-    float* below = &below_[below_start_[s]];
+    float* below = below_.data() + below_start_[s];
     for (int r = 0; r < rows_start_[s + 1] - rows_start_[s]; ++r) {
       for (int c = 0; c < width; ++c) *below++ = static_cast<float>(value[start[first + c] + width - c + r]);
     }
@@ -108,7 +108,7 @@ Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
   double part[kWidestSupernode];
   for (int s = 0; s < supernodes; ++s) {  // L·y = P·rhs
     const int first = first_column_[s], width = first_column_[s + 1] - first;
-    const double* diagonal = &diagonal_[diagonal_start_[s]];
+    const double* diagonal = diagonal_.data() + diagonal_start_[s];
     for (int c = 0; c < width; ++c) part[c] = y[first + c];
     for (int c = 0; c < width; ++c) {
       const double yc = (part[c] /= diagonal[c * width + c]);
@@ -117,7 +117,7 @@ Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
     }
     forEachWidth(width, [&](auto fixed_width) {
       const int w = widthOf(fixed_width, width);
-      const float* below = &below_[below_start_[s]];
+      const float* below = below_.data() + below_start_[s];
       for (int r = rows_start_[s]; r < rows_start_[s + 1]; ++r, below += w) {
         double sum = 0.0;
         for (int c = 0; c < w; ++c) sum += below[c] * part[c];
@@ -130,13 +130,13 @@ Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
     for (int c = 0; c < width; ++c) part[c] = y[first + c];
     forEachWidth(width, [&](auto fixed_width) {
       const int w = widthOf(fixed_width, width);
-      const float* below = &below_[below_start_[s]];
+      const float* below = below_.data() + below_start_[s];
       for (int r = rows_start_[s]; r < rows_start_[s + 1]; ++r, below += w) {
         const double yr = y[rows_[r]];
         for (int c = 0; c < w; ++c) part[c] -= below[c] * yr;
       }
     });
-    const double* diagonal = &diagonal_[diagonal_start_[s]];
+    const double* diagonal = diagonal_.data() + diagonal_start_[s];
     for (int c = width - 1; c >= 0; --c) {
       for (int r = c + 1; r < width; ++r) part[c] -= diagonal[c * width + r] * part[r];
       y[first + c] = part[c] /= diagonal[c * width + c];
