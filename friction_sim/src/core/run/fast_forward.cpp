@@ -28,20 +28,7 @@ StaticSolver* FastForward::pinnedSolver(LoadingSolve* loading) {
   }
   if (lifted != lifted_nodes_ || (lifted_nodes_.empty() && !pinned_solver_)) {
     creep_.forget();  // it knows its solver by address, which a solver taken back from the spare reuses
-    std::unique_ptr<StaticSolver> solver;
-    if (spare_solver_ && spare_lifted_nodes_ == lifted) {
-      solver = std::move(spare_solver_);
-      ++solver_reuses_;
-    }
-    // Free what is not kept before a factorisation. Multigrid solvers (10⁶ nodes) are never kept: two
-    // would not fit the memory budget.
-    spare_solver_.reset();
-    const std::size_t factor_bytes = pinned_solver_ ? pinned_solver_->directFactorBytes() : 0;
-    if (factor_bytes > 0 && factor_bytes <= kLargestSpareFactor) {
-      spare_solver_ = std::move(pinned_solver_);
-      spare_lifted_nodes_ = lifted_nodes_;
-    }
-    pinned_solver_.reset();
+    std::unique_ptr<StaticSolver> solver = exchangeWithSpare(lifted);
     lifted_nodes_.swap(lifted);
     std::vector<int> in_contact;
     for (int node = 0; node < contact.size(); ++node) {
@@ -52,7 +39,7 @@ StaticSolver* FastForward::pinnedSolver(LoadingSolve* loading) {
         solver = StaticSolver::withAddedSprings(std::move(loading->solver),
                                                 sim_.model_->anchorStiffness() - loading->anchor_stiffness);
       }
-      if (loading) loading->solver.reset();  // first, as above
+      if (loading) loading->solver.reset();  // freed before a factorisation, as the spare's leftovers
       if (!solver) {
         solver = std::make_unique<StaticSolver>(*sim_.model_, in_contact, false, StaticMethod::kAuto, lifted_nodes_);
         ++solver_setups_;
@@ -70,6 +57,24 @@ StaticSolver* FastForward::pinnedSolver(LoadingSolve* loading) {
     }
   }
   return pinned_solver_.get();
+}
+
+std::unique_ptr<StaticSolver> FastForward::exchangeWithSpare(const std::vector<int>& lifted) {
+  std::unique_ptr<StaticSolver> returning;
+  if (spare_solver_ && spare_lifted_nodes_ == lifted) {
+    returning = std::move(spare_solver_);
+    ++solver_reuses_;
+  }
+  // Free what is not kept before a factorisation. Multigrid solvers (10⁶ nodes) are never kept: two
+  // would not fit the memory budget.
+  spare_solver_.reset();
+  const std::size_t factor_bytes = pinned_solver_ ? pinned_solver_->directFactorBytes() : 0;
+  if (factor_bytes > 0 && factor_bytes <= kLargestSpareFactor) {
+    spare_solver_ = std::move(pinned_solver_);
+    spare_lifted_nodes_ = lifted_nodes_;
+  }
+  pinned_solver_.reset();
+  return returning;
 }
 
 bool FastForward::relaxToStaticEquilibrium() {

@@ -65,6 +65,10 @@ class FastForward {
  private:
   /// pinnedSolver(), made from `loading` (if not null) when it is set up.
   StaticSolver* pinnedSolver(LoadingSolve* loading);
+  /// Where the pinned solver is to be replaced for the nodes `lifted` off the track: the spare if it was
+  /// made for them (null otherwise); the current solver becomes the spare if it may be kept, and what is
+  /// not kept is freed.
+  std::unique_ptr<StaticSolver> exchangeWithSpare(const std::vector<int>& lifted);
   /// Where a jump along the equilibrium goes and how far.
   struct Path {
     Vector along;         ///< du/dX_s along the equilibrium
