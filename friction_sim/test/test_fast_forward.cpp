@@ -223,6 +223,17 @@ TEST(FastForward, GoesOnWithTheTrailingEdgeLiftedAndAgreesWithFullDynamics) {
   EXPECT_LT(std::abs(fast.energy().relativeResidual()), 5e-4);
 }
 
+TEST(FastForward, JumpsPredictedAlongThePathsCurvatureNeedFewerCorrections) {
+  // The default slider to its first global event: each jump starts from the path's slope and, once two
+  // secants have given it, its curvature. Measured: 61 corrections for 27 jumps (73 with the slope
+  // alone; 2.26 per jump against 2.70).
+  Simulation fast(loadScene(testing::scenePath("pmma_2d")));
+  fast.run();
+  ASSERT_EQ(fast.globalEventCount(), 1);
+  EXPECT_EQ(fast.jumps(), 27);
+  EXPECT_LE(fast.jumpCorrections(), 2.3 * fast.jumps());
+}
+
 TEST(FastForward, TakesBackTheSolverOfAContactSetThatReturns) {
   // Pressed lightly and pushed at the top, the trailing corner lifts and lands again after each global
   // event; the solver kept for the set before spares a factorisation each time that set returns.

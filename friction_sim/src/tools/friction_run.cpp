@@ -207,7 +207,8 @@ int run(int argc, char** argv) {
   }
   if (scene.integrator.fast_forward) {
     std::cout << "fast-forward: " << simulation.jumps() << " jumps covering " << simulation.jumpedTime() << " s of "
-              << simulation.time() << " s\n";
+              << simulation.time() << " s, brought to equilibrium by " << simulation.jumpCorrections()
+              << " corrections\n";
   }
   if (!results->finish(simulation, wall, std::cout)) {
     return refuseOutput(out_dir, "a result file could not be written in full");

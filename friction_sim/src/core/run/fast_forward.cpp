@@ -51,6 +51,7 @@ StaticSolver* FastForward::pinnedSolver(LoadingSolve* loading) {
       sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position(), here);
       sim_.model_->evaluate(sim_.u_, at_rest, sim_.stage_.position() + 1.0, moved);
       stage_response_ = solver->response(moved.force - here.force);
+      leaveBranch();
       pinned_solver_ = std::move(solver);
     } catch (const std::runtime_error&) {
       // Singular (too few nodes in contact hold the slider), or a multigrid solve that did not converge.
@@ -292,19 +293,38 @@ void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   const bool from_equilibrium = atEquilibrium();
   const AdvanceStart start = beginAdvance(path.length, end_time);
   const double stage_move = start.stage_end - start.stage_position;
+  const double middle = start.stage_position + 0.5 * stage_move;  // m, of the stage
   const Vector u_start = s.u_;
-  s.u_ += stage_move * path.along;
-  const bool converged = solver.solve(*s.model_, s.u_, start.stage_end) <= StaticSolver::kMaxIterations;
+  s.u_ += from_equilibrium ? predictedMove(middle, stage_move) : stage_move * path.along;
+  const int corrections = solver.solve(*s.model_, s.u_, start.stage_end);
+  jump_corrections_ += corrections;
+  const bool converged = corrections <= StaticSolver::kMaxIterations;
   const Vector secant = s.u_ - u_start;
   // From one equilibrium to the next along the path, and long enough that the solves' error is lost in it.
   if (converged && from_equilibrium && stage_move != 0.0 &&
       solver.tolerance() <= kSecantPrecision * secant.lpNorm<Eigen::Infinity>()) {
-    stage_response_ = secant / stage_move;
+    takeSecant(secant / stage_move, middle);
   }
   markEquilibrium(converged);
   s.v_.swap(path.velocity);
   jumped_time_ += path.length;
   concludeAdvance(start, s.time_, 0.0);
+}
+
+Vector FastForward::predictedMove(double middle, double stage_move) const {
+  if (slope_change_.size() == 0 || slope_branch_ != branch_) return stage_move * stage_response_;
+  return stage_move * (stage_response_ + (middle - slope_position_) * slope_change_);
+}
+
+void FastForward::takeSecant(const Vector& slope, double middle) {
+  if (slope_branch_ == branch_ && middle != slope_position_) {
+    slope_change_ = (slope - stage_response_) / (middle - slope_position_);
+  } else {
+    slope_change_.resize(0);
+  }
+  stage_response_ = slope;
+  slope_position_ = middle;
+  slope_branch_ = branch_;
 }
 
 void FastForward::markEquilibrium(bool at_equilibrium) {
@@ -325,6 +345,7 @@ bool FastForward::creepStep(double until) {
   }
   const Vector u_start = s.u_;
   markEquilibrium(false);  // one correction: near, not at, the creep's equilibrium
+  leaveBranch();
   const AdvanceStart start = beginAdvance(step.duration, endTime(until, step.duration));
   s.u_ += step.displacement;
   // The step's linearised motion is within a part in 10⁴ of equilibrium: one correction leaves a part in

@@ -81,6 +81,7 @@ void Simulation::refreshAfterStaticChange() {
 bool Simulation::quasiStatic() const { return fast_forward_->quasiStatic(); }
 bool Simulation::mayJump() const { return fast_forward_->mayJump(); }
 long long Simulation::jumps() const { return fast_forward_->jumps(); }
+long long Simulation::jumpCorrections() const { return fast_forward_->jumpCorrections(); }
 double Simulation::jumpedTime() const { return fast_forward_->jumpedTime(); }
 long long Simulation::staticSolverSetups() const { return fast_forward_->solverSetups(); }
 long long Simulation::staticSolverReuses() const { return fast_forward_->solverReuses(); }
