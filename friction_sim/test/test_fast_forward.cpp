@@ -225,13 +225,14 @@ TEST(FastForward, GoesOnWithTheTrailingEdgeLiftedAndAgreesWithFullDynamics) {
 
 TEST(FastForward, JumpsPredictedAlongThePathsCurvatureNeedFewerCorrections) {
   // The default slider to its first global event: each jump starts from the path's slope and, once two
-  // secants have given it, its curvature. Measured: 61 corrections for 27 jumps (73 with the slope
-  // alone; 2.26 per jump against 2.70).
+  // secants have given it, its curvature; each correction inverts the springs' tangent around the pushed
+  // node (StaticSolver::correct). Measured: 56 corrections for 27 jumps; 61 without the tangent, 73
+  // with the slope alone as well (2.07, 2.26 and 2.70 per jump).
   Simulation fast(loadScene(testing::scenePath("pmma_2d")));
   fast.run();
   ASSERT_EQ(fast.globalEventCount(), 1);
   EXPECT_EQ(fast.jumps(), 27);
-  EXPECT_LE(fast.jumpCorrections(), 2.3 * fast.jumps());
+  EXPECT_LE(fast.jumpCorrections(), 2.1 * fast.jumps());
 }
 
 TEST(FastForward, TakesBackTheSolverOfAContactSetThatReturns) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -241,6 +242,41 @@ TEST(LatticeNodeStiffness, BulkNodeThreeKAndCornerFiveQuarterK) {
   const double mean = 0.5 * (corner_x[0] + corner_z[1]);
   EXPECT_NEAR(mean + std::abs(corner_x[1]), 1.5 * k, 1e-6 * k);
   EXPECT_NEAR(mean - std::abs(corner_x[1]), 1.0 * k, 1e-6 * k);
+}
+
+TEST(LatticePusher, StiffnessChangeAtThePusherMakesTheMatrixTheSpringsTangentThere) {
+  // The pushed node displaced as a point load displaces it (strains of 1 % in its springs): the matrix
+  // plus the change gives the forces' derivative along either component of that node, all of whose
+  // springs lie among the six nodes of the change, to the finite difference's round-off.
+  Scene scene;  // pmma_2d: pushed at row 2
+  Lattice2D lattice(scene);
+  Vector u = Vector::Zero(lattice.dofCount());
+  lattice.connectPusher(u);
+  const int pushed = lattice.nodeIndex(0, lattice.pushedRows()[0]);
+  for (int i = 0; i < u.size(); ++i) u[i] = 1e-6 * std::sin(0.37 * i);
+  u[lattice.xDof(pushed)] += 2.5e-5;
+  u[lattice.zDof(pushed)] -= 1e-5;
+  const LocalStiffness change = lattice.stiffnessChangeAtPusher(u);
+  ASSERT_EQ(change.dofs.size(), 12u);
+  EXPECT_LT((change.matrix - change.matrix.transpose()).norm(), 1e-12 * change.matrix.norm());
+  const SparseMatrix stiffness = lattice.stiffnessMatrix();
+  for (int dof : {lattice.xDof(pushed), lattice.zDof(pushed)}) {
+    SCOPED_TRACE("dof " + std::to_string(dof));
+    const double step = 1e-9;  // m
+    ForceEvaluation ahead, behind;
+    lattice.evaluate(u + step * Vector::Unit(u.size(), dof), Vector::Zero(u.size()), 0.0, ahead);
+    lattice.evaluate(u - step * Vector::Unit(u.size(), dof), Vector::Zero(u.size()), 0.0, behind);
+    const Vector tangent = -(ahead.force - behind.force) / (2 * step);  // N/m
+    const Vector at_rest = stiffness.col(dof);
+    Vector changed = at_rest;
+    const auto column = std::find(change.dofs.begin(), change.dofs.end(), dof) - change.dofs.begin();
+    for (std::size_t r = 0; r < change.dofs.size(); ++r) changed[change.dofs[r]] += change.matrix(r, column);
+    EXPECT_LT((changed - tangent).norm(), 1e-6 * tangent.norm());
+    EXPECT_GT((at_rest - tangent).norm(), 3e-3 * tangent.norm());
+  }
+  // Without the pusher, no point load: nothing to change.
+  lattice.disconnectPusher();
+  EXPECT_TRUE(lattice.stiffnessChangeAtPusher(u).dofs.empty());
 }
 
 TEST(LatticeSpringForm, LinearisedForcesAgreeWithGeometricAtSmallStrain) {

@@ -75,6 +75,9 @@ class Lattice2D : public Model {
   NodeStiffness nodeStiffness() const override;
   /// The foundation's k_f on the node's u_z.
   void releaseContact(SparseMatrix& stiffness, int node) const override;
+  /// Up to kMostRowsForLocalTangent pushed rows; a band pushed wider spreads its load.
+  LocalStiffness stiffnessChangeAtPusher(const Vector& u) const override;
+  static constexpr int kMostRowsForLocalTangent = 2;
   SparseMatrix dampingMatrix() const override;
   Vector anchorStiffness() const override;
   /// 6k: the infinite lattice's largest, at the wave vector (π/l, 0).

@@ -52,6 +52,12 @@ NodeStiffness collectNodeStiffness(int nodes, int components, Fill&& fill) {
   return blocks;
 }
 
+/// A dense change to a stiffness matrix on a few of its degrees of freedom.
+struct LocalStiffness {
+  std::vector<int> dofs;   ///< the model's degrees of freedom it acts on
+  Eigen::MatrixXd matrix;  ///< N/m, symmetric, one row and column per entry of `dofs`
+};
+
 /// What one force evaluation produces; friction is not included.
 struct ForceEvaluation {
   Vector force;                ///< N, per degree of freedom
@@ -155,6 +161,11 @@ class Model {
   /// The node blocks of stiffnessMatrix(), equal to its entries, without assembling it (the stability
   /// bound reads no more).
   virtual NodeStiffness nodeStiffness() const = 0;
+  /// The tangent stiffness at displacements `u` minus stiffnessMatrix(), on the springs among the pushed
+  /// nodes and their nearest neighbours: there the pusher's point load strains the springs most, and
+  /// their geometry departs most from the matrix linearised at rest. Empty where the springs are
+  /// linear, or no pusher is connected.
+  virtual LocalStiffness stiffnessChangeAtPusher(const Vector& /*u*/) const { return {}; }
   /// Takes out of `stiffness` (the matrix above) the contact stiffness of interface node `node`, for an
   /// equilibrium in which that node is off the track.
   virtual void releaseContact(SparseMatrix& stiffness, int node) const = 0;

@@ -1,7 +1,8 @@
 // Static equilibrium of the slider with some degrees of freedom held fixed, by modified Newton: the
 // linearised stiffness of the free degrees of freedom is factored once (CHOLMOD's simplicial Cholesky) and
 // corrects the residual of the full (geometric, one-sided) forces until they balance (through the factor
-// rounded to single precision: the residual, in double, sets the equilibrium). Used for the
+// rounded to single precision: the residual, in double, sets the equilibrium), with the springs around
+// the pusher's point load at their tangent. Used for the
 // loading protocol and, with the interface pinned, for the quasi-static fast-forward. A lattice too
 // large for the factor's memory is solved by multigrid-preconditioned conjugate gradients instead.
 #pragma once
@@ -62,8 +63,10 @@ class StaticSolver {
 
   /// One iteration of solve(), without re-balancing a top load: for a state already near equilibrium,
   /// whose residual it reduces by the factor's error (10⁻² or less on the 2D lattice, measured at 113 × 61
-  /// with the double factor; the single-precision copy adds about 10⁻⁸ at 225 × 121). Returns the largest
-  /// displacement it corrected (m).
+  /// with the double factor; the single-precision copy adds about 10⁻⁸ at 225 × 121). With a direct
+  /// factor, the stiffness it inverts is the factored one plus the model's stiffnessChangeAtPusher() at
+  /// `u`, by Woodbury's identity: the springs around a point load are where most of that error comes
+  /// from. Returns the largest displacement it corrected (m).
   double correct(const Model& model, Vector& u, double stage_position, const Vector& body_force = Vector()) const;
 
   /// Displacement of the free degrees of freedom per unit of a force vector on them (K_ff⁻¹·f).
@@ -83,6 +86,9 @@ class StaticSolver {
   Vector reducedResponse(const Vector& reduced, bool single_precision = false) const;
   /// response(), through the single-precision factor if `single_precision`.
   Vector response(const Vector& force, bool single_precision) const;
+  /// Turns `solution`, the factored stiffness's response on the free degrees of freedom, into that of the
+  /// stiffness changed by `change` (those of its dofs that are free), by Woodbury's identity.
+  void addLocalChange(const LocalStiffness& change, Vector& solution) const;
   /// correct(), through the single-precision factor if `single_precision`.
   double correct(const Model& model, Vector& u, double stage_position, const Vector& body_force,
                  bool single_precision) const;
@@ -96,6 +102,12 @@ class StaticSolver {
   std::vector<int> spring_positions_;
   Eigen::MatrixXd spring_response_;
   Eigen::LLT<Eigen::MatrixXd> capacitance_;
+  /// For addLocalChange: the free positions of the dofs of the last change, the response to a unit
+  /// force at each (one column each, with any added springs) and its rows at them. Made on first use:
+  /// a solver may never need them (the loading's), and they cost a solve per dof.
+  mutable std::vector<int> change_positions_;
+  mutable Eigen::MatrixXd change_response_;
+  mutable Eigen::MatrixXd change_response_at_;
   double tolerance_;
   bool balance_load_;
 };

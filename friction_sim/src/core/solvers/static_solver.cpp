@@ -3,6 +3,7 @@
 #include "solvers/cholesky_factor.h"
 #include "solvers/grid_multigrid.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -117,6 +118,36 @@ Vector StaticSolver::reducedResponse(const Vector& reduced, bool single_precisio
   return solution;
 }
 
+void StaticSolver::addLocalChange(const LocalStiffness& change, Vector& solution) const {
+  std::vector<int> positions, rows;  // the free ones among the change's dofs, and their rows in it
+  for (std::size_t r = 0; r < change.dofs.size(); ++r) {
+    const auto at = std::lower_bound(free_dofs_.begin(), free_dofs_.end(), change.dofs[r]);
+    if (at == free_dofs_.end() || *at != change.dofs[r]) continue;
+    positions.push_back(static_cast<int>(at - free_dofs_.begin()));
+    rows.push_back(static_cast<int>(r));
+  }
+  if (positions.empty()) return;
+  const int count = static_cast<int>(positions.size());
+  if (positions != change_positions_) {
+    change_positions_ = positions;
+    change_response_.resize(free_dofs_.size(), count);
+    for (int c = 0; c < count; ++c) {
+      change_response_.col(c) = reducedResponse(Vector::Unit(free_dofs_.size(), positions[c]));
+    }
+    change_response_at_.resize(count, count);
+    for (int r = 0; r < count; ++r) change_response_at_.row(r) = change_response_.row(positions[r]);
+  }
+  // (K + U·M·Uᵀ)⁻¹·f = x − W·(I + M·Uᵀ·W)⁻¹·M·Uᵀ·x with x = K⁻¹·f and W = K⁻¹·U; M need not be definite.
+  Eigen::MatrixXd change_here(count, count);
+  Eigen::VectorXd at_change(count);
+  for (int r = 0; r < count; ++r) {
+    for (int c = 0; c < count; ++c) change_here(r, c) = change.matrix(rows[r], rows[c]);
+    at_change[r] = solution[positions[r]];
+  }
+  const Eigen::MatrixXd capacitance = Eigen::MatrixXd::Identity(count, count) + change_here * change_response_at_;
+  solution -= change_response_ * capacitance.partialPivLu().solve(change_here * at_change);
+}
+
 std::unique_ptr<StaticSolver> StaticSolver::withAddedSprings(std::unique_ptr<StaticSolver> base,
                                                              const Vector& added_stiffness) {
   std::vector<int> positions;
@@ -147,6 +178,7 @@ std::unique_ptr<StaticSolver> StaticSolver::withAddedSprings(std::unique_ptr<Sta
   if (base->capacitance_.info() != Eigen::Success) return nullptr;
   base->spring_positions_ = std::move(positions);
   base->spring_response_ = std::move(response);
+  base->change_positions_.clear();  // their responses were the base's alone
   return base;
 }
 
@@ -160,8 +192,11 @@ double StaticSolver::correct(const Model& model, Vector& u, double stage_positio
   ForceEvaluation evaluation;
   model.evaluate(u, Vector::Zero(u.size()), stage_position, evaluation);
   if (body_force.size() > 0) evaluation.force += body_force;
-  const Vector correction = response(evaluation.force, single_precision);
-  u += correction;
+  Vector reduced(free_dofs_.size());
+  for (std::size_t i = 0; i < free_dofs_.size(); ++i) reduced[i] = evaluation.force[free_dofs_[i]];
+  Vector correction = reducedResponse(reduced, single_precision);
+  if (factor_) addLocalChange(model.stiffnessChangeAtPusher(u), correction);
+  for (std::size_t i = 0; i < free_dofs_.size(); ++i) u[free_dofs_[i]] += correction[i];
   return correction.lpNorm<Eigen::Infinity>();
 }
 
