@@ -104,7 +104,7 @@ class StaticSolver {
   Eigen::LLT<Eigen::MatrixXd> capacitance_;
   /// For addLocalChange: the free positions of the dofs of the last change, the response to a unit
   /// force at each (one column each, with any added springs) and its rows at them. Made on first use:
-  /// a solver may never need them (the loading's), and they cost a solve per dof.
+  /// a solver may never need them (the loading's), and they cost a single-precision solve per dof.
   mutable std::vector<int> change_positions_;
   mutable Eigen::MatrixXd change_response_;
   mutable Eigen::MatrixXd change_response_at_;
