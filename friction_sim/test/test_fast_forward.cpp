@@ -226,8 +226,8 @@ TEST(FastForward, GoesOnWithTheTrailingEdgeLiftedAndAgreesWithFullDynamics) {
 TEST(FastForward, JumpsPredictedAlongThePathsCurvatureNeedFewerCorrections) {
   // The default slider to its first global event: each jump starts from the path's slope and, once two
   // secants have given it, its curvature; each correction inverts the springs' tangent around the pushed
-  // node (StaticSolver::correct). Measured: 56 corrections for 27 jumps; 61 without the tangent, 73
-  // with the slope alone as well (2.07, 2.26 and 2.70 per jump).
+  // node (StaticSolver::correct). Measured: 54 corrections for 27 jumps; 61 without the tangent, 73
+  // with the slope alone as well (2.00, 2.26 and 2.70 per jump).
   Simulation fast(loadScene(testing::scenePath("pmma_2d")));
   fast.run();
   ASSERT_EQ(fast.globalEventCount(), 1);

@@ -2,6 +2,7 @@
 // equilibrium, and a multigrid iteration count that does not grow with the lattice.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "friction_sim/solvers/static_solver.h"
@@ -125,6 +126,47 @@ TEST(StaticSolver, AutomaticChoiceFactorsAChain) {
   // The internal forces reach the total pull (5·10⁵ N); the residual is round-off against them.
   EXPECT_LT(residual.lpNorm<Eigen::Infinity>(), 1e-9 * pull.sum());
   EXPECT_EQ(solver.multigridIterations(), 0);
+}
+
+TEST(StaticSolver, ACorrectionInvertsTheFactoredStiffnessPlusThePushersTangent) {
+  // One correction from a state strained around the pusher: its step solves (K + ΔK)·du = f, with ΔK
+  // the springs' tangent there (Model::stiffnessChangeAtPusher, added by Woodbury's identity), to the
+  // single-precision factor's error; K's own step is off by much more.
+  auto model = pmmaLattice(29, 16);
+  Vector u = Vector::Zero(model->dofCount());
+  model->connectPusher(u);
+  for (int dof : model->stiffnessChangeAtPusher(u).dofs) u[dof] = 2e-5 * std::sin(1.0 + dof);  // 1 % strains
+  const LocalStiffness change = model->stiffnessChangeAtPusher(u);
+  ASSERT_FALSE(change.dofs.empty());
+  std::vector<int> fixed;
+  for (int node = 0; node < model->interfaceNodeCount(); ++node) fixed.push_back(model->interfaceDof(node));
+  const StaticSolver solver(*model, fixed);
+  Vector stepped = u;
+  solver.correct(*model, stepped, 0.0);
+  const std::vector<int>& free = solver.freeDofs();
+  const int n = static_cast<int>(free.size());
+  Eigen::MatrixXd stiffness = Eigen::MatrixXd(model->stiffnessMatrix());
+  Eigen::MatrixXd changed = stiffness;
+  for (std::size_t r = 0; r < change.dofs.size(); ++r) {
+    for (std::size_t c = 0; c < change.dofs.size(); ++c) changed(change.dofs[r], change.dofs[c]) += change.matrix(r, c);
+  }
+  ForceEvaluation evaluation;
+  model->evaluate(u, Vector::Zero(u.size()), 0.0, evaluation);
+  Eigen::MatrixXd stiffness_free(n, n), changed_free(n, n);
+  Vector force(n), step(n);
+  for (int r = 0; r < n; ++r) {
+    force[r] = evaluation.force[free[r]];
+    step[r] = stepped[free[r]] - u[free[r]];
+    for (int c = 0; c < n; ++c) {
+      stiffness_free(r, c) = stiffness(free[r], free[c]);
+      changed_free(r, c) = changed(free[r], free[c]);
+    }
+  }
+  const Vector expected = changed_free.ldlt().solve(force);
+  const Vector unchanged = stiffness_free.ldlt().solve(force);
+  const double size = expected.lpNorm<Eigen::Infinity>();
+  EXPECT_LT((step - expected).lpNorm<Eigen::Infinity>(), 1e-5 * size);
+  EXPECT_GT((unchanged - expected).lpNorm<Eigen::Infinity>(), 1e-3 * size);
 }
 
 TEST(StaticSolver, MultigridIterationsDoNotGrowWithTheLattice) {

@@ -62,7 +62,8 @@ class Simulation : public Dynamics {
   /// Fast-forward jumps taken, and simulated time (s) they covered.
   long long jumps() const;
   double jumpedTime() const;
-  /// The corrections (sparse solves) that brought fast-forward's jumps to equilibrium, all told.
+  /// The corrections (sparse solves) that brought fast-forward's jumps along the equilibrium to it (creep
+  /// steps, one correction each, are not counted; a solve that gave up counts its kMaxIterations).
   long long jumpCorrections() const;
   /// Fast-forward's static solvers set up after the loading (factorisations of a new contact set), and
   /// taken back for a contact set that returned.

@@ -103,8 +103,9 @@ class StaticSolver {
   Eigen::MatrixXd spring_response_;
   Eigen::LLT<Eigen::MatrixXd> capacitance_;
   /// For addLocalChange: the free positions of the dofs of the last change, the response to a unit
-  /// force at each (one column each, with any added springs) and its rows at them. Made on first use:
-  /// a solver may never need them (the loading's), and they cost a single-precision solve per dof.
+  /// force at each (one column each, with any added springs) and its rows at them. Made on first use
+  /// (so correct() is not for several threads at once): a solver may never need them (a loading without
+  /// the pusher), and they cost a single-precision solve per dof.
   mutable std::vector<int> change_positions_;
   mutable Eigen::MatrixXd change_response_;
   mutable Eigen::MatrixXd change_response_at_;

@@ -104,6 +104,7 @@ bool FastForward::relaxToStaticEquilibrium() {
   s.u_ = relaxed;
   s.v_.setZero();
   markEquilibrium(true);
+  ++relaxations_;
   s.refreshAfterStaticChange();
   approaching_threshold_ = false;
   return true;
@@ -297,7 +298,7 @@ void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
   const Vector u_start = s.u_;
   s.u_ += from_equilibrium ? predictedMove(middle, stage_move) : stage_move * path.along;
   const int corrections = solver.solve(*s.model_, s.u_, start.stage_end);
-  jump_corrections_ += corrections;
+  jump_corrections_ += std::min(corrections, StaticSolver::kMaxIterations);
   const bool converged = corrections <= StaticSolver::kMaxIterations;
   const Vector secant = s.u_ - u_start;
   // From one equilibrium to the next along the path, and long enough that the solves' error is lost in it.
@@ -313,18 +314,25 @@ void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
 
 Vector FastForward::predictedMove(double middle, double stage_move) const {
   if (slope_change_.size() == 0 || slope_branch_ != branch_) return stage_move * stage_response_;
-  return stage_move * (stage_response_ + (middle - slope_position_) * slope_change_);
+  const Vector turn = (middle - slope_position_) * slope_change_;
+  // Extrapolated far (across an event) or from a noisy difference, the turn could outgrow the slope
+  // itself: the slope alone is then the safer start.
+  if (!(turn.lpNorm<Eigen::Infinity>() <= stage_response_.lpNorm<Eigen::Infinity>())) {
+    return stage_move * stage_response_;
+  }
+  return stage_move * (stage_response_ + turn);
 }
 
 void FastForward::takeSecant(const Vector& slope, double middle) {
-  if (slope_branch_ == branch_ && middle != slope_position_) {
-    slope_change_ = (slope - stage_response_) / (middle - slope_position_);
-  } else {
+  if (slope_branch_ != branch_) {
     slope_change_.resize(0);
-  }
+  } else if (slope_relaxation_ == relaxations_ && middle != slope_position_) {
+    slope_change_ = (slope - stage_response_) / (middle - slope_position_);
+  }  // else across an event: the slope jumped, and the curvature before it is the better estimate
   stage_response_ = slope;
   slope_position_ = middle;
   slope_branch_ = branch_;
+  slope_relaxation_ = relaxations_;
 }
 
 void FastForward::markEquilibrium(bool at_equilibrium) {

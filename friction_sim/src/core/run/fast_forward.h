@@ -117,7 +117,8 @@ class FastForward {
   /// The slider left the branch of equilibria it was following (a creep step, another contact set):
   /// slopes taken before do not give the curvature of the next. An event and the relaxation after it
   /// do not: the curvature, which comes mostly from the springs around the pushed node, changes little
-  /// across them (at 225 × 121 kept: 163 corrections to the first global event; reset: 185).
+  /// across them (at 225 × 121 kept: 163 corrections to the first global event; reset: 185), though
+  /// the slope jumps, so that the secants on either side of an event give no curvature.
   void leaveBranch() { ++branch_; }
   /// s, how far an advance towards `until` (s) may go: to `until`, the stop time, the stage's next change
   /// or its travel limit.
@@ -184,8 +185,10 @@ class FastForward {
   /// the slope's middle: corrections after it start at 10⁻⁸–10⁻⁹ m at 113 × 61, and each gains only a
   /// factor of about 80 (modified Newton on the unloaded stiffness, mostly at the pushed node).
   Vector slope_change_;
-  long long branch_ = 0;         ///< counts leaveBranch()
-  long long slope_branch_ = -1;  ///< the branch stage_response_ was taken on as a secant (-1: none)
+  long long branch_ = 0;             ///< counts leaveBranch()
+  long long slope_branch_ = -1;      ///< the branch stage_response_ was taken on as a secant (-1: none)
+  long long relaxations_ = 0;        ///< relaxations to static equilibrium so far (after events)
+  long long slope_relaxation_ = -1;  ///< relaxations_ when stage_response_ was taken as a secant
   /// The state is a converged pinned equilibrium (the loaded one, a relaxation's or a jump's), as long as
   /// no step has been taken since `equilibrium_steps_`.
   bool at_equilibrium_ = true;
