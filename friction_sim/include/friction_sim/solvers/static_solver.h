@@ -86,6 +86,8 @@ class StaticSolver {
   Vector reducedResponse(const Vector& reduced, bool single_precision = false) const;
   /// response(), through the single-precision factor if `single_precision`.
   Vector response(const Vector& force, bool single_precision) const;
+  /// The responses (free dofs) to a unit force at each free position in `positions`, one column each.
+  Eigen::MatrixXd unitResponses(const std::vector<int>& positions, bool single_precision) const;
   /// Turns `solution`, the factored stiffness's response on the free degrees of freedom, into that of the
   /// stiffness changed by `change` (those of its dofs that are free), by Woodbury's identity.
   void addLocalChange(const LocalStiffness& change, Vector& solution) const;

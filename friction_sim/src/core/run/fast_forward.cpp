@@ -104,7 +104,7 @@ bool FastForward::relaxToStaticEquilibrium() {
   s.u_ = relaxed;
   s.v_.setZero();
   markEquilibrium(true);
-  ++relaxations_;
+  if (last_secant_ == LastSecant::kOnPath) last_secant_ = LastSecant::kBeforeEvent;
   s.refreshAfterStaticChange();
   approaching_threshold_ = false;
   return true;
@@ -313,7 +313,7 @@ void FastForward::takeJump(StaticSolver& solver, Path& path, double end_time) {
 }
 
 Vector FastForward::predictedMove(double middle, double stage_move) const {
-  if (slope_change_.size() == 0 || slope_branch_ != branch_) return stage_move * stage_response_;
+  if (slope_change_.size() == 0) return stage_move * stage_response_;
   const Vector turn = (middle - slope_position_) * slope_change_;
   // Extrapolated far (across an event) or from a noisy difference, the turn could outgrow the slope
   // itself: the slope alone is then the safer start.
@@ -324,15 +324,18 @@ Vector FastForward::predictedMove(double middle, double stage_move) const {
 }
 
 void FastForward::takeSecant(const Vector& slope, double middle) {
-  if (slope_branch_ != branch_) {
-    slope_change_.resize(0);
-  } else if (slope_relaxation_ == relaxations_ && middle != slope_position_) {
+  // Across an event the slope jumped, and the curvature from before it is the better estimate.
+  if (last_secant_ == LastSecant::kOnPath && middle != slope_position_) {
     slope_change_ = (slope - stage_response_) / (middle - slope_position_);
-  }  // else across an event: the slope jumped, and the curvature before it is the better estimate
+  }
   stage_response_ = slope;
   slope_position_ = middle;
-  slope_branch_ = branch_;
-  slope_relaxation_ = relaxations_;
+  last_secant_ = LastSecant::kOnPath;
+}
+
+void FastForward::leaveBranch() {
+  slope_change_.resize(0);
+  last_secant_ = LastSecant::kNone;
 }
 
 void FastForward::markEquilibrium(bool at_equilibrium) {

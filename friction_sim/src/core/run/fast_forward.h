@@ -119,7 +119,7 @@ class FastForward {
   /// do not: the curvature, which comes mostly from the springs around the pushed node, changes little
   /// across them (at 225 × 121 kept: 163 corrections to the first global event; reset: 185), though
   /// the slope jumps, so that the secants on either side of an event give no curvature.
-  void leaveBranch() { ++branch_; }
+  void leaveBranch();
   /// s, how far an advance towards `until` (s) may go: to `until`, the stop time, the stage's next change
   /// or its travel limit.
   double spanAhead(double until) const;
@@ -180,15 +180,15 @@ class FastForward {
   /// m of the stage's position where stage_response_ is the path's slope: the middle of the jump whose
   /// secant it is.
   double slope_position_ = 0.0;
-  /// d²u/dX_s² (1/m), from the last two secants taken on one branch; empty if there are not two. A jump
+  /// d²u/dX_s² (1/m), from the last two secants taken on one branch; empty until there are two. A jump
   /// predicted by the slope alone lands off the path by the curvature times the jump and the way back to
   /// the slope's middle: corrections after it start at 10⁻⁸–10⁻⁹ m at 113 × 61, and each gains only a
   /// factor of about 80 (modified Newton on the unloaded stiffness, mostly at the pushed node).
   Vector slope_change_;
-  long long branch_ = 0;             ///< counts leaveBranch()
-  long long slope_branch_ = -1;      ///< the branch stage_response_ was taken on as a secant (-1: none)
-  long long relaxations_ = 0;        ///< relaxations to static equilibrium so far (after events)
-  long long slope_relaxation_ = -1;  ///< relaxations_ when stage_response_ was taken as a secant
+  /// What stage_response_ is on the branch followed now: no secant of it, a secant taken before the last
+  /// event's relaxation, or one taken on the path since.
+  enum class LastSecant { kNone, kBeforeEvent, kOnPath };
+  LastSecant last_secant_ = LastSecant::kNone;
   /// The state is a converged pinned equilibrium (the loaded one, a relaxation's or a jump's), as long as
   /// no step has been taken since `equilibrium_steps_`.
   bool at_equilibrium_ = true;

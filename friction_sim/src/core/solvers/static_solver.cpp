@@ -50,6 +50,20 @@ SparseMatrix freeStiffness(const Model& model, const std::vector<int>& lifted_no
   return stiffness;
 }
 
+/// `vector`'s entries at `indices`, in their order.
+Vector entriesAt(const Vector& vector, const std::vector<int>& indices) {
+  Vector out(indices.size());
+  for (std::size_t i = 0; i < indices.size(); ++i) out[i] = vector[indices[i]];
+  return out;
+}
+
+/// `matrix`'s rows at `indices`, in their order.
+Eigen::MatrixXd rowsAt(const Eigen::MatrixXd& matrix, const std::vector<int>& indices) {
+  Eigen::MatrixXd out(indices.size(), matrix.cols());
+  for (std::size_t r = 0; r < indices.size(); ++r) out.row(r) = matrix.row(indices[r]);
+  return out;
+}
+
 /// The model's dofs as a grid of nodes (every model is one: the chain's is n × 1).
 GridLayout gridLayoutOf(const Model& model) {
   const auto shape = model.gridShape();
@@ -92,9 +106,7 @@ StaticSolver::StaticSolver(const Model& model, const std::vector<int>& fixed_dof
 Vector StaticSolver::response(const Vector& force) const { return response(force, false); }
 
 Vector StaticSolver::response(const Vector& force, bool single_precision) const {
-  Vector reduced(free_dofs_.size());
-  for (std::size_t i = 0; i < free_dofs_.size(); ++i) reduced[i] = force[free_dofs_[i]];
-  const Vector solution = reducedResponse(reduced, single_precision);
+  const Vector solution = reducedResponse(entriesAt(force, free_dofs_), single_precision);
   Vector out = Vector::Zero(force.size());
   for (std::size_t i = 0; i < free_dofs_.size(); ++i) out[free_dofs_[i]] = solution[i];
   return out;
@@ -111,11 +123,18 @@ Vector StaticSolver::reducedResponse(const Vector& reduced, bool single_precisio
   }
   if (!spring_positions_.empty()) {
     // (K + U·D·Uᵀ)⁻¹·f = x − W·(D⁻¹ + Uᵀ·W)⁻¹·Uᵀ·x with x = K⁻¹·f and W = K⁻¹·U.
-    Eigen::VectorXd at_springs(spring_positions_.size());
-    for (std::size_t c = 0; c < spring_positions_.size(); ++c) at_springs[c] = solution[spring_positions_[c]];
+    const Eigen::VectorXd at_springs = entriesAt(solution, spring_positions_);
     solution -= spring_response_ * capacitance_.solve(at_springs);
   }
   return solution;
+}
+
+Eigen::MatrixXd StaticSolver::unitResponses(const std::vector<int>& positions, bool single_precision) const {
+  Eigen::MatrixXd responses(free_dofs_.size(), positions.size());
+  for (std::size_t c = 0; c < positions.size(); ++c) {
+    responses.col(c) = reducedResponse(Vector::Unit(free_dofs_.size(), positions[c]), single_precision);
+  }
+  return responses;
 }
 
 void StaticSolver::addLocalChange(const LocalStiffness& change, Vector& solution) const {
@@ -130,23 +149,18 @@ void StaticSolver::addLocalChange(const LocalStiffness& change, Vector& solution
   const int count = static_cast<int>(positions.size());
   if (positions != change_positions_) {
     change_positions_ = positions;
-    change_response_.resize(free_dofs_.size(), count);
     // Through the single-precision factor: an error in W, its condition number times about 6·10⁻⁸, only
     // slows the corrections by that times the change (about 1 % of the springs' stiffness) and leaves
     // their fixed point alone.
-    for (int c = 0; c < count; ++c) {
-      change_response_.col(c) = reducedResponse(Vector::Unit(free_dofs_.size(), positions[c]), true);
-    }
-    change_response_at_.resize(count, count);
-    for (int r = 0; r < count; ++r) change_response_at_.row(r) = change_response_.row(positions[r]);
+    change_response_ = unitResponses(positions, true);
+    change_response_at_ = rowsAt(change_response_, positions);
   }
   // (K + U·M·Uᵀ)⁻¹·f = x − W·(I + M·Uᵀ·W)⁻¹·M·Uᵀ·x with x = K⁻¹·f and W = K⁻¹·U; M need not be definite.
   Eigen::MatrixXd change_here(count, count);
-  Eigen::VectorXd at_change(count);
   for (int r = 0; r < count; ++r) {
     for (int c = 0; c < count; ++c) change_here(r, c) = change.matrix(rows[r], rows[c]);
-    at_change[r] = solution[positions[r]];
   }
+  const Eigen::VectorXd at_change = entriesAt(solution, positions);
   const Eigen::MatrixXd capacitance = Eigen::MatrixXd::Identity(count, count) + change_here * change_response_at_;
   const Eigen::VectorXd at_response = capacitance.partialPivLu().solve(change_here * at_change);
   // A singular capacitance (a tangent that lost its definiteness) leaves the factored stiffness alone.
@@ -170,16 +184,9 @@ std::unique_ptr<StaticSolver> StaticSolver::withAddedSprings(std::unique_ptr<Sta
   }
   base->balance_load_ = false;
   if (positions.empty()) return base;
-  const int count = static_cast<int>(positions.size());
-  Eigen::MatrixXd response(base->free_dofs_.size(), count);
-  for (int c = 0; c < count; ++c) {
-    response.col(c) = base->reducedResponse(Vector::Unit(base->free_dofs_.size(), positions[c]));
-  }
-  Eigen::MatrixXd capacitance(count, count);
-  for (int r = 0; r < count; ++r) {
-    for (int c = 0; c < count; ++c) capacitance(r, c) = response(positions[r], c);
-    capacitance(r, r) += 1.0 / stiffness[r];
-  }
+  Eigen::MatrixXd response = base->unitResponses(positions, false);
+  Eigen::MatrixXd capacitance = rowsAt(response, positions);
+  for (std::size_t r = 0; r < positions.size(); ++r) capacitance(r, r) += 1.0 / stiffness[r];
   base->capacitance_.compute(capacitance);
   if (base->capacitance_.info() != Eigen::Success) return nullptr;
   base->spring_positions_ = std::move(positions);
@@ -198,9 +205,7 @@ double StaticSolver::correct(const Model& model, Vector& u, double stage_positio
   ForceEvaluation evaluation;
   model.evaluate(u, Vector::Zero(u.size()), stage_position, evaluation);
   if (body_force.size() > 0) evaluation.force += body_force;
-  Vector reduced(free_dofs_.size());
-  for (std::size_t i = 0; i < free_dofs_.size(); ++i) reduced[i] = evaluation.force[free_dofs_[i]];
-  Vector correction = reducedResponse(reduced, single_precision);
+  Vector correction = reducedResponse(entriesAt(evaluation.force, free_dofs_), single_precision);
   if (factor_) addLocalChange(model.stiffnessChangeAtPusher(u), correction);
   for (std::size_t i = 0; i < free_dofs_.size(); ++i) u[free_dofs_[i]] += correction[i];
   return correction.lpNorm<Eigen::Infinity>();
