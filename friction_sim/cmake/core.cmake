@@ -56,6 +56,9 @@ endif()
 # that record off into a memcpy call, a second pass over the forces and a call per strip.
 set_source_files_properties(src/core/contact/contact_interface.cpp PROPERTIES COMPILE_OPTIONS -fno-tree-loop-distribute-patterns)
 target_link_libraries(friction_sim_core PUBLIC yaml-cpp ${CHOLMOD_LIBRARY} PRIVATE OpenMP::OpenMP_CXX)
+# OpenMP is for the lattice's own threads: Eigen's dense products (the factorisation's updates) stay on
+# the calling thread, whatever OMP_NUM_THREADS says (two threads cost more than they gave on panels this small).
+target_compile_definitions(friction_sim_core PUBLIC EIGEN_DONT_PARALLELIZE)
 # Calls between the core's own source files bind inside the library too, without the PLT.
 target_link_options(friction_sim_core PRIVATE -Wl,-Bsymbolic-functions)
 

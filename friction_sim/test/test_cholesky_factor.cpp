@@ -1,4 +1,4 @@
-// The direct method's factor: CHOLMOD's solve in double, and the single-precision copy in supernodes
+// The direct method's factor: its own supernodal factorisation and solve in double, and the single-precision copy
 // that the modified-Newton corrections use.
 #include <gtest/gtest.h>
 

@@ -1,7 +1,8 @@
 #include "solvers/cholesky_factor.h"
 
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
 #include <algorithm>
-#include <numeric>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -9,7 +10,7 @@
 namespace friction {
 
 namespace {
-/// The widths whose loops over columns are unrolled: the narrow supernodes, which are nearly all.
+/// The widths whose loops over columns are unrolled: the narrow blocks, which are nearly all.
 constexpr int kUnrolledWidths = 8;
 
 /// Calls `body` with std::integral_constant<int, width> for widths 1 to kUnrolledWidths, with
@@ -30,85 +31,223 @@ template <typename FixedWidth>
 int widthOf(FixedWidth, int width) {
   return FixedWidth::value > 0 ? FixedWidth::value : width;
 }
+
+/// The factor's pattern from CHOLMOD's supernodal analysis: its fill-reducing ordering and its
+/// supernodes, runs of columns stored together as one dense column-major panel (relaxed: a few explicit
+/// zeros buy wider panels, whose updates are dense matrix products).
+struct SupernodalPattern {
+  std::vector<int> fill_order;    ///< the factor's row k is the matrix's row fill_order[k]
+  std::vector<int> first_column;  ///< supernode s spans columns [first_column[s], first_column[s + 1])
+  std::vector<int> rows_start;    ///< its rows rows[rows_start[s] ...], its own columns first
+  std::vector<int> rows;
+  std::vector<std::size_t> panel_start;  ///< its panel, rows × columns, from panel_start[s]
+
+  int supernodes() const { return static_cast<int>(first_column.size()) - 1; }
+  int width(int s) const { return first_column[s + 1] - first_column[s]; }
+  int height(int s) const { return rows_start[s + 1] - rows_start[s]; }
+};
+
+/// CHOLMOD's workspace, finished however the analysis ends.
+class CholmodCommon {
+ public:
+  CholmodCommon() { cholmod_start(&common_); }
+  ~CholmodCommon() { cholmod_finish(&common_); }
+  CholmodCommon(const CholmodCommon&) = delete;
+  CholmodCommon& operator=(const CholmodCommon&) = delete;
+  cholmod_common* get() { return &common_; }
+
+ private:
+  cholmod_common common_;
+};
+
+SupernodalPattern analyse(const SparseMatrix& lower) {
+  CholmodCommon common;
+  common.get()->supernodal = CHOLMOD_SUPERNODAL;
+  cholmod_sparse matrix = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
+  cholmod_factor* factor = cholmod_analyze(&matrix, common.get());
+  if (!factor) throw std::runtime_error("static solve: CHOLMOD could not order the stiffness matrix");
+  SupernodalPattern pattern;
+  if (factor->is_super && factor->itype == CHOLMOD_INT) {
+    const int n = static_cast<int>(factor->n), supernodes = static_cast<int>(factor->nsuper);
+    const int* perm = static_cast<const int*>(factor->Perm);
+    const int* super = static_cast<const int*>(factor->super);
+    const int* pi = static_cast<const int*>(factor->pi);
+    const int* px = static_cast<const int*>(factor->px);
+    const int* s = static_cast<const int*>(factor->s);
+    pattern.fill_order.assign(perm, perm + n);
+    pattern.first_column.assign(super, super + supernodes + 1);
+    pattern.rows_start.assign(pi, pi + supernodes + 1);
+    pattern.rows.assign(s, s + pi[supernodes]);
+    pattern.panel_start.assign(px, px + supernodes + 1);
+  }
+  cholmod_free_factor(&factor, common.get());
+  if (pattern.first_column.empty()) {
+    throw std::logic_error("CholeskyFactor: CHOLMOD did not give a supernodal pattern with int indices");
+  }
+  return pattern;
+}
+
+/// The lower triangle of P·A·Pᵀ (A = `lower`'s symmetric matrix, P the factor's ordering) by columns.
+struct PermutedLower {
+  std::vector<int> start, rows;
+  std::vector<double> values;
+};
+
+PermutedLower permute(const SparseMatrix& lower, const std::vector<int>& fill_order) {
+  const int n = static_cast<int>(fill_order.size());
+  std::vector<int> position(n);
+  for (int k = 0; k < n; ++k) position[fill_order[k]] = k;
+  PermutedLower permuted;
+  permuted.start.assign(n + 1, 0);
+  for (int j = 0; j < n; ++j) {
+    for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
+      ++permuted.start[std::min(position[it.row()], position[j]) + 1];
+    }
+  }
+  for (int k = 0; k < n; ++k) permuted.start[k + 1] += permuted.start[k];
+  std::vector<int> next(permuted.start.begin(), permuted.start.end() - 1);
+  permuted.rows.resize(permuted.start[n]);
+  permuted.values.resize(permuted.start[n]);
+  for (int j = 0; j < n; ++j) {
+    for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
+      const int a = position[it.row()], b = position[j];
+      const int at = next[std::min(a, b)]++;
+      permuted.rows[at] = std::max(a, b);
+      permuted.values[at] = it.value();
+    }
+  }
+  return permuted;
+}
+
+using Panel = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+
+/// The numeric factorisation, left-looking by supernodes: each supernode's panel gathers the matrix's
+/// columns, subtracts the updates of the supernodes below it in the elimination tree that reach its
+/// columns (one dense product each), then factors its diagonal block and solves the rows below it.
+/// Returns the panels.
+std::vector<double> factorise(const SparseMatrix& lower, const SupernodalPattern& pattern) {
+  const int n = static_cast<int>(pattern.fill_order.size()), supernodes = pattern.supernodes();
+  const PermutedLower matrix = permute(lower, pattern.fill_order);
+  std::vector<double> panels(pattern.panel_start[supernodes], 0.0);
+  std::vector<int> supernode_of(n);
+  for (int s = 0; s < supernodes; ++s) {
+    std::fill(supernode_of.begin() + pattern.first_column[s], supernode_of.begin() + pattern.first_column[s + 1], s);
+  }
+  // Supernodes waiting to update supernode s: a list from pending[s] through next_pending; each knows
+  // where its rows reach s's columns (reached[d]).
+  std::vector<int> pending(supernodes, -1), next_pending(supernodes, -1), reached(supernodes, 0);
+  const auto enqueue = [&](int d, int row_position) {
+    reached[d] = row_position;
+    if (row_position == pattern.height(d)) return;
+    const int target = supernode_of[pattern.rows[pattern.rows_start[d] + row_position]];
+    next_pending[d] = pending[target];
+    pending[target] = d;
+  };
+  std::vector<int> row_in_panel(n), target_rows;
+  Eigen::MatrixXd update;
+  for (int s = 0; s < supernodes; ++s) {
+    const int first = pattern.first_column[s], end = pattern.first_column[s + 1], width = end - first;
+    const int height = pattern.height(s);
+    const int* rows = pattern.rows.data() + pattern.rows_start[s];
+    Panel panel(panels.data() + pattern.panel_start[s], height, width, Eigen::OuterStride<>(height));
+    for (int r = 0; r < height; ++r) row_in_panel[rows[r]] = r;
+    for (int k = first; k < end; ++k) {
+      for (int at = matrix.start[k]; at < matrix.start[k + 1]; ++at) {
+        panel(row_in_panel[matrix.rows[at]], k - first) = matrix.values[at];
+      }
+    }
+    for (int d = pending[s]; d != -1;) {
+      const int after = next_pending[d];
+      const int d_height = pattern.height(d);
+      const int* d_rows = pattern.rows.data() + pattern.rows_start[d];
+      const int top = reached[d];
+      int inside = top;
+      while (inside < d_height && d_rows[inside] < end) ++inside;
+      const Panel d_panel(panels.data() + pattern.panel_start[d], d_height, pattern.width(d),
+                          Eigen::OuterStride<>(d_height));
+      const int below = d_height - top, across = inside - top;
+      update.noalias() = d_panel.middleRows(top, below) * d_panel.middleRows(top, across).transpose();
+      target_rows.resize(below);
+      for (int i = 0; i < below; ++i) target_rows[i] = row_in_panel[d_rows[top + i]];
+      for (int j = 0; j < across; ++j) {
+        double* column = &panel(0, d_rows[top + j] - first);
+        for (int i = j; i < below; ++i) column[target_rows[i]] -= update(i, j);
+      }
+      enqueue(d, inside);
+      d = after;
+    }
+    Eigen::Ref<Eigen::MatrixXd> diagonal_block = panel.topRows(width);
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> in_place(diagonal_block);
+    if (in_place.info() != Eigen::Success || !diagonal_block.diagonal().allFinite()) {
+      throw std::runtime_error("static solve: the stiffness matrix is singular");
+    }
+    diagonal_block.triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(
+        panel.bottomRows(height - width));
+    enqueue(s, width);
+  }
+  return panels;
+}
 }  // namespace
 
-CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) : cholmod_(lower) {
-  if (cholmod_.info() != Eigen::Success) throw std::runtime_error("static solve: the stiffness matrix is singular");
-  const cholmod_factor& factor = cholmod_.factor();
-  if (factor.is_super || !factor.is_ll || factor.xtype != CHOLMOD_REAL || factor.itype != CHOLMOD_INT) {
-    throw std::logic_error("CholeskyFactor: CHOLMOD did not give a simplicial real LLᵀ factor with int indices");
-  }
-  const int n = static_cast<int>(factor.n);
-  const int* perm = static_cast<const int*>(factor.Perm);
-  if (perm) {
-    fill_order_.assign(perm, perm + n);
-  } else {  // the natural ordering
-    fill_order_.resize(n);
-    std::iota(fill_order_.begin(), fill_order_.end(), 0);
-  }
-  // A simplicial factor's columns need not be packed: column j holds nz[j] entries from p[j], the
-  // diagonal first, its rows ascending.
-  const int* start = static_cast<const int*>(factor.p);
-  const int* count = static_cast<const int*>(factor.nz);
-  const int* row = static_cast<const int*>(factor.i);
-  const double* value = static_cast<const double*>(factor.x);
-  // Column j + 1 continues column j's supernode when its pattern below the diagonal is column j's
-  // without row j + 1.
-  const auto continues = [&](int j) {
-    return count[j + 1] == count[j] - 1 && count[j] > 1 && row[start[j] + 1] == j + 1 &&
-           std::equal(row + start[j] + 2, row + start[j] + count[j], row + start[j + 1] + 1);
-  };
+CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) {
+  const SupernodalPattern pattern = analyse(lower);
+  std::vector<double> panels = factorise(lower, pattern);
+  fill_order_ = pattern.fill_order;
+  // Each supernode in blocks of at most kWidestBlock columns; a block's rows below its diagonal block
+  // are the rest of its supernode's columns and the supernode's rows below them.
   first_column_ = {0};
   diagonal_start_ = {0};
   rows_start_ = {0};
   below_start_ = {0};
-  for (int first = 0; first < n;) {
-    int width = 1;
-    while (first + width < n && width < kWidestSupernode && continues(first + width - 1)) ++width;
-    const int below_count = count[first] - width;
-    first += width;
-    first_column_.push_back(first);
-    diagonal_start_.push_back(diagonal_start_.back() + width * width);
-    rows_start_.push_back(rows_start_.back() + below_count);
-    below_start_.push_back(below_start_.back() + below_count * width);
+  for (int s = 0; s < pattern.supernodes(); ++s) {
+    const int first = pattern.first_column[s], end = pattern.first_column[s + 1];
+    for (int block_first = first; block_first < end; block_first += kWidestBlock) {
+      const int block_end = std::min(block_first + kWidestBlock, end), width = block_end - block_first;
+      const int below_count = pattern.height(s) - (block_end - first);
+      first_column_.push_back(block_end);
+      diagonal_start_.push_back(diagonal_start_.back() + width * width);
+      rows_start_.push_back(rows_start_.back() + below_count);
+      below_start_.push_back(below_start_.back() + below_count * width);
+    }
   }
-  // Sized at once: growing by doubling could hold twice the copy while it is made (hundreds of MB).
+  // Sized at once: growing by doubling could hold twice the factor while it is copied (hundreds of MB).
   diagonal_.assign(diagonal_start_.back(), 0.0);
   rows_.resize(rows_start_.back());
   below_.resize(below_start_.back());
-  for (std::size_t s = 0; s + 1 < first_column_.size(); ++s) {
-    const int first = first_column_[s], width = first_column_[s + 1] - first;
-    for (int c = 0; c < width; ++c) {
-      const int column_start = start[first + c];
-      for (int r = c; r < width; ++r) diagonal_[diagonal_start_[s] + c * width + r] = value[column_start + r - c];
-    }
-    std::copy(row + start[first] + width, row + start[first] + count[first], rows_.begin() + rows_start_[s]);
-    float* below = below_.data() + below_start_[s];
-    for (int r = 0; r < rows_start_[s + 1] - rows_start_[s]; ++r) {
-      for (int c = 0; c < width; ++c) *below++ = static_cast<float>(value[start[first + c] + width - c + r]);
+  std::size_t block = 0;
+  for (int s = 0; s < pattern.supernodes(); ++s) {
+    const int first = pattern.first_column[s], height = pattern.height(s);
+    const int* rows = pattern.rows.data() + pattern.rows_start[s];
+    const double* panel = panels.data() + pattern.panel_start[s];
+    for (; block + 1 < first_column_.size() && first_column_[block] < pattern.first_column[s + 1]; ++block) {
+      const int offset = first_column_[block] - first, width = first_column_[block + 1] - first_column_[block];
+      for (int c = 0; c < width; ++c) {
+        for (int r = c; r < width; ++r) {
+          diagonal_[diagonal_start_[block] + c * width + r] = panel[(offset + c) * height + offset + r];
+        }
+      }
+      std::copy(rows + offset + width, rows + height, rows_.begin() + rows_start_[block]);
+      double* below = below_.data() + below_start_[block];
+      for (int r = offset + width; r < height; ++r) {
+        for (int c = 0; c < width; ++c) *below++ = panel[(offset + c) * height + r];
+      }
     }
   }
+  panels = std::vector<double>();  // freed before the single-precision copy is made
+  below_single_.assign(below_.begin(), below_.end());
 }
 
-Vector CholeskyFactor::solve(const Vector& rhs) const { return cholmod_.solve(rhs); }
-
-std::size_t CholeskyFactor::bytes() const {
-  return cholmod_.factor().nzmax * (sizeof(double) + sizeof(int)) + fill_order_.size() * sizeof(int) +
-         (first_column_.size() + diagonal_start_.size() + rows_start_.size() + below_start_.size() + rows_.size()) *
-             sizeof(int) +
-         diagonal_.size() * sizeof(double) + below_.size() * sizeof(float);
-}
-
-Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
+template <typename Entry>
+Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const Vector& rhs) const {
   const int n = static_cast<int>(fill_order_.size());
   Vector y(n);
   for (int k = 0; k < n; ++k) y[k] = rhs[fill_order_[k]];
-  const int supernodes = static_cast<int>(first_column_.size()) - 1;
-  // One supernode's part of y, kept apart: the compiler cannot tell it from the rows below it.
-  double part[kWidestSupernode];
-  for (int s = 0; s < supernodes; ++s) {  // L·y = P·rhs
-    const int first = first_column_[s], width = first_column_[s + 1] - first;
-    const double* diagonal = diagonal_.data() + diagonal_start_[s];
+  const int blocks = static_cast<int>(first_column_.size()) - 1;
+  // One block's part of y, kept apart: the compiler cannot tell it from the rows below it.
+  double part[kWidestBlock];
+  for (int b = 0; b < blocks; ++b) {  // L·y = P·rhs
+    const int first = first_column_[b], width = first_column_[b + 1] - first;
+    const double* diagonal = diagonal_.data() + diagonal_start_[b];
     for (int c = 0; c < width; ++c) part[c] = y[first + c];
     for (int c = 0; c < width; ++c) {
       const double yc = (part[c] /= diagonal[c * width + c]);
@@ -117,26 +256,26 @@ Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
     }
     forEachWidth(width, [&](auto fixed_width) {
       const int w = widthOf(fixed_width, width);
-      const float* below = below_.data() + below_start_[s];
-      for (int r = rows_start_[s]; r < rows_start_[s + 1]; ++r, below += w) {
+      const Entry* below = below_entries.data() + below_start_[b];
+      for (int r = rows_start_[b]; r < rows_start_[b + 1]; ++r, below += w) {
         double sum = 0.0;
         for (int c = 0; c < w; ++c) sum += below[c] * part[c];
         y[rows_[r]] -= sum;
       }
     });
   }
-  for (int s = supernodes - 1; s >= 0; --s) {  // Lᵀ·z = y
-    const int first = first_column_[s], width = first_column_[s + 1] - first;
+  for (int b = blocks - 1; b >= 0; --b) {  // Lᵀ·z = y
+    const int first = first_column_[b], width = first_column_[b + 1] - first;
     for (int c = 0; c < width; ++c) part[c] = y[first + c];
     forEachWidth(width, [&](auto fixed_width) {
       const int w = widthOf(fixed_width, width);
-      const float* below = below_.data() + below_start_[s];
-      for (int r = rows_start_[s]; r < rows_start_[s + 1]; ++r, below += w) {
+      const Entry* below = below_entries.data() + below_start_[b];
+      for (int r = rows_start_[b]; r < rows_start_[b + 1]; ++r, below += w) {
         const double yr = y[rows_[r]];
         for (int c = 0; c < w; ++c) part[c] -= below[c] * yr;
       }
     });
-    const double* diagonal = diagonal_.data() + diagonal_start_[s];
+    const double* diagonal = diagonal_.data() + diagonal_start_[b];
     for (int c = width - 1; c >= 0; --c) {
       for (int r = c + 1; r < width; ++r) part[c] -= diagonal[c * width + r] * part[r];
       y[first + c] = part[c] /= diagonal[c * width + c];
@@ -145,6 +284,17 @@ Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
   Vector solution(n);
   for (int k = 0; k < n; ++k) solution[fill_order_[k]] = y[k];
   return solution;
+}
+
+Vector CholeskyFactor::solve(const Vector& rhs) const { return sweep(below_, rhs); }
+
+Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const { return sweep(below_single_, rhs); }
+
+std::size_t CholeskyFactor::bytes() const {
+  return (fill_order_.size() + first_column_.size() + diagonal_start_.size() + rows_start_.size() +
+          below_start_.size() + rows_.size()) *
+             sizeof(int) +
+         (diagonal_.size() + below_.size()) * sizeof(double) + below_single_.size() * sizeof(float);
 }
 
 }  // namespace friction
