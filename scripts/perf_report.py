@@ -322,10 +322,10 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
         lines.append("| %s | %.2f | %.0f |" % (w["label"], w["wall"], w["peak_mb"]))
     lines += ["", "The 10⁶-node run's loading solve (2.1·10⁶ free degrees of freedom) "
               "uses conjugate gradients preconditioned by a geometric multigrid V-cycle (`GridMultigrid`: bilinear "
-              "transfer, Galerkin coarse matrices, one Gauss–Seidel sweep each way, CHOLMOD on the coarsest level); "
-              "lattices above 4·10⁵ free degrees of freedom use it, smaller ones CHOLMOD's direct factor. Measured by "
-              "hand on this machine (2026-11-21): the direct factor has 2.4·10⁸ non-zeros at 10⁶ nodes (2.2 GB, "
-              "whatever ordering CHOLMOD uses) and the same run with it peaked at 2957 MB in 144 s; multigrid needs "
+              "transfer, Galerkin coarse matrices, one Gauss–Seidel sweep each way, the direct factor on the coarsest "
+              "level); lattices above 4·10⁵ free degrees of freedom use it, smaller ones the direct factor. Measured "
+              "by hand (2026-11-21, with CHOLMOD's factor then): the direct factor has 2.4·10⁸ non-zeros at 10⁶ nodes "
+              "(2.2 GB, whatever ordering CHOLMOD used) and the same run with it peaked at 2957 MB in 144 s; multigrid needs "
               "11–12 iterations to a 10⁻¹⁰ residual at 57 × 31, 113 × 61 and 225 × 121 alike (tested)."]
     reference_global = first_global(reference["events"])
     lines += ["", "## Every mode against the reference", "",

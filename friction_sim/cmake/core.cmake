@@ -4,12 +4,13 @@ find_package(Eigen3 REQUIRED)
 find_package(yaml-cpp REQUIRED)
 # Threads for the large lattices' force sweeps (Lattice2D::setThreads).
 find_package(OpenMP REQUIRED COMPONENTS CXX)
-# CHOLMOD (SuiteSparse): supernodal Cholesky with nested-dissection ordering keeps the static solves of
-# large lattices within memory (Eigen's simplicial LDLT needed > 3 GB at 10^6 nodes).
-find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
-find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
-# Eigen's and CHOLMOD's headers for every target from here on (the core's solvers and their tests use both).
-include_directories(SYSTEM ${EIGEN3_INCLUDE_DIR} ${CHOLMOD_INCLUDE_DIR})
+# AMD (SuiteSparse): the fill-reducing ordering of the static solver's Cholesky factor (its numeric
+# factorisation is the core's own). Only AMD is linked: CHOLMOD and the BLAS it pulls in cost 2 ms of
+# loading per process, a tenth of a small run's start-up.
+find_path(AMD_INCLUDE_DIR amd.h PATH_SUFFIXES suitesparse REQUIRED)
+find_library(AMD_LIBRARY amd REQUIRED)
+# Eigen's and AMD's headers for every target from here on (the core's solvers and their tests use both).
+include_directories(SYSTEM ${EIGEN3_INCLUDE_DIR} ${AMD_INCLUDE_DIR})
 
 add_library(friction_sim_core
   src/core/contact/contact_interface.cpp
@@ -55,7 +56,7 @@ endif()
 # The friction loop records each node's force as it turns it into an acceleration; GCC would split
 # that record off into a memcpy call, a second pass over the forces and a call per strip.
 set_source_files_properties(src/core/contact/contact_interface.cpp PROPERTIES COMPILE_OPTIONS -fno-tree-loop-distribute-patterns)
-target_link_libraries(friction_sim_core PUBLIC yaml-cpp ${CHOLMOD_LIBRARY} PRIVATE OpenMP::OpenMP_CXX)
+target_link_libraries(friction_sim_core PUBLIC yaml-cpp ${AMD_LIBRARY} PRIVATE OpenMP::OpenMP_CXX)
 # OpenMP is for the lattice's own threads: Eigen's dense products (the factorisation's updates) stay on
 # the calling thread, whatever OMP_NUM_THREADS says (two threads cost more than they gave on panels this small).
 target_compile_definitions(friction_sim_core PUBLIC EIGEN_DONT_PARALLELIZE)

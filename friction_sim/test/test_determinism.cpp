@@ -22,7 +22,7 @@ struct Pin {
 
 constexpr Pin kPins[] = {
     {"single_block", 0x33ff500570b44db8ULL}, {"pmma_1d_side", 0xefe502c3334be423ULL},
-    {"pmma_1d_top", 0x40584551a61e4f73ULL},  {"pmma_2d", 0x4fab295529ae331ULL},
+    {"pmma_1d_top", 0x40584551a61e4f73ULL},  {"pmma_2d", 0x1259b0dd968c1da4ULL},
     {"rate_state", 0x03eab833bf944af1ULL},
 };
 

@@ -1,5 +1,5 @@
 // Static equilibrium of the slider with some degrees of freedom held fixed, by modified Newton: the
-// linearised stiffness of the free degrees of freedom is factored once (CHOLMOD's simplicial Cholesky) and
+// linearised stiffness of the free degrees of freedom is factored once (a supernodal Cholesky factor) and
 // corrects the residual of the full (geometric, one-sided) forces until they balance (through the factor
 // rounded to single precision: the residual, in double, sets the equilibrium), with the springs around
 // the pusher's point load at their tangent. Used for the
@@ -21,7 +21,7 @@ class GridMultigrid;
 /// How the linearised stiffness is inverted.
 enum class StaticMethod {
   kAuto,       ///< direct up to kDirectSolveDofs free degrees of freedom, multigrid above
-  kDirect,     ///< CHOLMOD's simplicial Cholesky factor
+  kDirect,     ///< a sparse Cholesky factor (CholeskyFactor)
   kMultigrid,  ///< conjugate gradients with a geometric multigrid V-cycle (grid models only)
 };
 

@@ -1,8 +1,10 @@
 #include "solvers/cholesky_factor.h"
 
-#include <Eigen/CholmodSupport>
+#include <amd.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
+#include <numeric>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -32,71 +34,17 @@ int widthOf(FixedWidth, int width) {
   return FixedWidth::value > 0 ? FixedWidth::value : width;
 }
 
-/// The factor's pattern from CHOLMOD's supernodal analysis: its fill-reducing ordering and its
-/// supernodes, runs of columns stored together as one dense column-major panel (relaxed: a few explicit
-/// zeros buy wider panels, whose updates are dense matrix products).
-struct SupernodalPattern {
-  std::vector<int> fill_order;    ///< the factor's row k is the matrix's row fill_order[k]
-  std::vector<int> first_column;  ///< supernode s spans columns [first_column[s], first_column[s + 1])
-  std::vector<int> rows_start;    ///< its rows rows[rows_start[s] ...], its own columns first
-  std::vector<int> rows;
-  std::vector<std::size_t> panel_start;  ///< its panel, rows × columns, from panel_start[s]
-
-  int supernodes() const { return static_cast<int>(first_column.size()) - 1; }
-  int width(int s) const { return first_column[s + 1] - first_column[s]; }
-  int height(int s) const { return rows_start[s + 1] - rows_start[s]; }
-};
-
-/// CHOLMOD's workspace, finished however the analysis ends.
-class CholmodCommon {
- public:
-  CholmodCommon() { cholmod_start(&common_); }
-  ~CholmodCommon() { cholmod_finish(&common_); }
-  CholmodCommon(const CholmodCommon&) = delete;
-  CholmodCommon& operator=(const CholmodCommon&) = delete;
-  cholmod_common* get() { return &common_; }
-
- private:
-  cholmod_common common_;
-};
-
-SupernodalPattern analyse(const SparseMatrix& lower) {
-  CholmodCommon common;
-  common.get()->supernodal = CHOLMOD_SUPERNODAL;
-  cholmod_sparse matrix = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
-  cholmod_factor* factor = cholmod_analyze(&matrix, common.get());
-  if (!factor) throw std::runtime_error("static solve: CHOLMOD could not order the stiffness matrix");
-  SupernodalPattern pattern;
-  if (factor->is_super && factor->itype == CHOLMOD_INT) {
-    const int n = static_cast<int>(factor->n), supernodes = static_cast<int>(factor->nsuper);
-    const int* perm = static_cast<const int*>(factor->Perm);
-    const int* super = static_cast<const int*>(factor->super);
-    const int* pi = static_cast<const int*>(factor->pi);
-    const int* px = static_cast<const int*>(factor->px);
-    const int* s = static_cast<const int*>(factor->s);
-    pattern.fill_order.assign(perm, perm + n);
-    pattern.first_column.assign(super, super + supernodes + 1);
-    pattern.rows_start.assign(pi, pi + supernodes + 1);
-    pattern.rows.assign(s, s + pi[supernodes]);
-    pattern.panel_start.assign(px, px + supernodes + 1);
-  }
-  cholmod_free_factor(&factor, common.get());
-  if (pattern.first_column.empty()) {
-    throw std::logic_error("CholeskyFactor: CHOLMOD did not give a supernodal pattern with int indices");
-  }
-  return pattern;
-}
-
-/// The lower triangle of P·A·Pᵀ (A = `lower`'s symmetric matrix, P the factor's ordering) by columns.
+/// The lower triangle of P·A·Pᵀ (A = `lower`'s symmetric matrix, P an ordering) by columns.
 struct PermutedLower {
   std::vector<int> start, rows;
   std::vector<double> values;
 };
 
-PermutedLower permute(const SparseMatrix& lower, const std::vector<int>& fill_order) {
-  const int n = static_cast<int>(fill_order.size());
+/// `lower` ordered by `order` (row k of the result is the matrix's row order[k]).
+PermutedLower permute(const SparseMatrix& lower, const std::vector<int>& order) {
+  const int n = static_cast<int>(order.size());
   std::vector<int> position(n);
-  for (int k = 0; k < n; ++k) position[fill_order[k]] = k;
+  for (int k = 0; k < n; ++k) position[order[k]] = k;
   PermutedLower permuted;
   permuted.start.assign(n + 1, 0);
   for (int j = 0; j < n; ++j) {
@@ -117,6 +65,230 @@ PermutedLower permute(const SparseMatrix& lower, const std::vector<int>& fill_or
     }
   }
   return permuted;
+}
+
+/// A pattern by columns: column k's rows are rows[start[k] ... start[k + 1]).
+struct Pattern {
+  std::vector<int> start, rows;
+  int size() const { return static_cast<int>(start.size()) - 1; }
+};
+
+/// The columns above the diagonal of a permuted lower triangle's symmetric matrix: column k lists the
+/// rows i < k with an entry (its row k left of the diagonal), ascending.
+Pattern aboveDiagonal(const PermutedLower& matrix) {
+  const int n = static_cast<int>(matrix.start.size()) - 1;
+  Pattern above{std::vector<int>(n + 1, 0), {}};
+  for (int c = 0; c < n; ++c) {
+    for (int at = matrix.start[c]; at < matrix.start[c + 1]; ++at)
+      above.start[matrix.rows[at] + 1] += matrix.rows[at] != c;
+  }
+  for (int c = 0; c < n; ++c) above.start[c + 1] += above.start[c];
+  std::vector<int> next(above.start.begin(), above.start.end() - 1);
+  above.rows.resize(above.start[n]);
+  for (int c = 0; c < n; ++c) {
+    for (int at = matrix.start[c]; at < matrix.start[c + 1]; ++at) {
+      if (matrix.rows[at] != c) above.rows[next[matrix.rows[at]]++] = c;
+    }
+  }
+  return above;
+}
+
+/// The elimination tree: parent[j] is the first row below j in column j of the factor (−1 at a root).
+std::vector<int> eliminationTree(const Pattern& above) {
+  const int n = above.size();
+  std::vector<int> parent(n, -1), ancestor(n, -1);
+  for (int k = 0; k < n; ++k) {
+    for (int at = above.start[k]; at < above.start[k + 1]; ++at) {
+      int i = above.rows[at];
+      // Up from i to the root of its subtree so far, compressing the path to k on the way.
+      while (i != -1 && i < k) {
+        const int up = ancestor[i];
+        ancestor[i] = k;
+        if (up == -1) parent[i] = k;
+        i = up;
+      }
+    }
+  }
+  return parent;
+}
+
+/// Each column's count of entries in the factor: row k has an entry in every column on the tree's
+/// paths from the columns of its entries left of the diagonal up to k.
+std::vector<int> columnCounts(const Pattern& above, const std::vector<int>& parent) {
+  const int n = above.size();
+  std::vector<int> count(n, 1), mark(n, -1);
+  for (int k = 0; k < n; ++k) {
+    mark[k] = k;
+    for (int at = above.start[k]; at < above.start[k + 1]; ++at) {
+      for (int j = above.rows[at]; mark[j] != k; j = parent[j]) {
+        mark[j] = k;
+        ++count[j];
+      }
+    }
+  }
+  return count;
+}
+
+/// The tree's nodes in postorder (every subtree's nodes consecutive), each node's children by
+/// ascending `weight`: the heaviest child comes last, next to its parent, where the two can share a
+/// supernode.
+std::vector<int> postorder(const std::vector<int>& parent, const std::vector<int>& weight) {
+  const int n = static_cast<int>(parent.size());
+  std::vector<int> by_weight(n);
+  std::iota(by_weight.begin(), by_weight.end(), 0);
+  std::sort(by_weight.begin(), by_weight.end(),
+            [&](int a, int b) { return weight[a] != weight[b] ? weight[a] > weight[b] : a > b; });
+  std::vector<int> first_child(n, -1), next_sibling(n, -1), order, stack;
+  for (int j : by_weight) {
+    if (parent[j] == -1) continue;
+    next_sibling[j] = first_child[parent[j]];
+    first_child[parent[j]] = j;
+  }
+  order.reserve(n);
+  for (int root = 0; root < n; ++root) {
+    if (parent[root] != -1) continue;
+    stack.push_back(root);
+    while (!stack.empty()) {
+      const int top = stack.back();
+      const int child = first_child[top];
+      if (child == -1) {
+        order.push_back(top);
+        stack.pop_back();
+      } else {
+        first_child[top] = next_sibling[child];  // visited: the next child comes next time
+        stack.push_back(child);
+      }
+    }
+  }
+  return order;
+}
+
+/// The factor's pattern: its fill-reducing ordering (SuiteSparse's AMD, then the elimination tree's
+/// postorder) and its supernodes, runs of columns stored together as one dense column-major panel.
+/// Relaxed as CHOLMOD relaxes them: a few explicit zeros buy wider panels, whose updates are dense
+/// matrix products.
+struct SupernodalPattern {
+  std::vector<int> fill_order;    ///< the factor's row k is the matrix's row fill_order[k]
+  std::vector<int> first_column;  ///< supernode s spans columns [first_column[s], first_column[s + 1])
+  std::vector<int> rows_start;    ///< its rows rows[rows_start[s] ...], its own columns first
+  std::vector<int> rows;
+  std::vector<std::size_t> panel_start;  ///< its panel, rows × columns, from panel_start[s]
+
+  int supernodes() const { return static_cast<int>(first_column.size()) - 1; }
+  int width(int s) const { return first_column[s + 1] - first_column[s]; }
+  int height(int s) const { return rows_start[s + 1] - rows_start[s]; }
+};
+
+/// Whether a supernode of `columns` columns with `zeros` of its `entries` explicit is worth its zeros
+/// (CHOLMOD's default relaxation).
+bool relaxedEnough(int columns, double zeros, double entries) {
+  const double fraction = zeros / entries;
+  return columns <= 4 || (columns <= 16 && fraction < 0.8) || (columns <= 48 && fraction < 0.1) || fraction < 0.05;
+}
+
+SupernodalPattern analyse(const SparseMatrix& lower) {
+  const int n = static_cast<int>(lower.rows());
+  SupernodalPattern pattern;
+  std::vector<int> minimum_degree(n);
+  {
+    const SparseMatrix compressed = lower.isCompressed() ? SparseMatrix() : SparseMatrix(lower);
+    const SparseMatrix& matrix = lower.isCompressed() ? lower : compressed;
+    double control[AMD_CONTROL], info[AMD_INFO];
+    amd_defaults(control);
+    const int status =
+        amd_order(n, matrix.outerIndexPtr(), matrix.innerIndexPtr(), minimum_degree.data(), control, info);
+    if (status != AMD_OK && status != AMD_OK_BUT_JUMBLED) {
+      throw std::runtime_error("static solve: AMD could not order the stiffness matrix");
+    }
+  }
+  const Pattern above = aboveDiagonal(permute(lower, minimum_degree));
+  const std::vector<int> tree_parent = eliminationTree(above);
+  const std::vector<int> tree_count = columnCounts(above, tree_parent);
+  const std::vector<int> post = postorder(tree_parent, tree_count);
+  // The tree and the counts relabelled in postorder.
+  std::vector<int> position(n), parent(n), count(n), children(n, 0);
+  for (int k = 0; k < n; ++k) position[post[k]] = k;
+  pattern.fill_order.resize(n);
+  for (int k = 0; k < n; ++k) {
+    pattern.fill_order[k] = minimum_degree[post[k]];
+    parent[k] = tree_parent[post[k]] == -1 ? -1 : position[tree_parent[post[k]]];
+    count[k] = tree_count[post[k]];
+    if (parent[k] != -1) ++children[parent[k]];
+  }
+  // Fundamental supernodes: a column continues the one before when that is its only child and its
+  // pattern is the child's without it.
+  struct Group {
+    int first, columns, height;  ///< height: the first column's rows, its own columns included
+    double zeros;                ///< explicit zeros
+  };
+  std::vector<Group> fundamental;
+  for (int first = 0; first < n;) {
+    int end = first + 1;
+    while (end < n && parent[end - 1] == end && children[end] == 1 && count[end] == count[end - 1] - 1) ++end;
+    fundamental.push_back({first, end - first, count[first], 0.0});
+    first = end;
+  }
+  // Relaxed from the root down: a fundamental supernode whose parent's first column follows its last
+  // (its parent's last child) joins the group that parent is in while relaxedEnough.
+  const auto entries = [](int columns, int height) {
+    return static_cast<double>(columns) * height - 0.5 * static_cast<double>(columns) * (columns - 1);
+  };
+  std::vector<Group> groups;  // from the top down
+  for (int f = static_cast<int>(fundamental.size()) - 1; f >= 0; --f) {
+    const Group& child = fundamental[f];
+    const int last = child.first + child.columns - 1;
+    if (!groups.empty() && parent[last] == last + 1) {
+      Group& above = groups.back();
+      const Group merged{child.first, child.columns + above.columns, child.columns + above.height,
+                         above.zeros + entries(child.columns + above.columns, child.columns + above.height) -
+                             entries(child.columns, child.height) - entries(above.columns, above.height)};
+      if (relaxedEnough(merged.columns, merged.zeros, entries(merged.columns, merged.height))) {
+        above = merged;
+        continue;
+      }
+    }
+    groups.push_back(child);
+  }
+  std::reverse(groups.begin(), groups.end());
+  // Each supernode's rows: its own columns, then the rows below them of its matrix columns and of its
+  // children's patterns.
+  const int supernodes = static_cast<int>(groups.size());
+  std::vector<int> supernode_of(n);
+  pattern.first_column = {0};
+  pattern.rows_start = {0};
+  pattern.panel_start = {0};
+  for (int s = 0; s < supernodes; ++s) {
+    std::fill(supernode_of.begin() + groups[s].first, supernode_of.begin() + groups[s].first + groups[s].columns, s);
+    pattern.first_column.push_back(groups[s].first + groups[s].columns);
+  }
+  std::vector<std::vector<int>> child_supernodes(supernodes);
+  std::vector<int> below;
+  const PermutedLower matrix = permute(lower, pattern.fill_order);
+  std::vector<int> mark(n, -1);
+  for (int s = 0; s < supernodes; ++s) {
+    const int first = pattern.first_column[s], end = pattern.first_column[s + 1];
+    below.clear();
+    const auto add = [&](int row) {
+      if (row >= end && mark[row] != s) {
+        mark[row] = s;
+        below.push_back(row);
+      }
+    };
+    for (int k = first; k < end; ++k) {
+      for (int at = matrix.start[k]; at < matrix.start[k + 1]; ++at) add(matrix.rows[at]);
+    }
+    for (int child : child_supernodes[s]) {
+      for (int at = pattern.rows_start[child]; at < pattern.rows_start[child + 1]; ++at) add(pattern.rows[at]);
+    }
+    std::sort(below.begin(), below.end());
+    for (int k = first; k < end; ++k) pattern.rows.push_back(k);
+    pattern.rows.insert(pattern.rows.end(), below.begin(), below.end());
+    pattern.rows_start.push_back(static_cast<int>(pattern.rows.size()));
+    pattern.panel_start.push_back(pattern.panel_start.back() +
+                                  static_cast<std::size_t>(pattern.height(s)) * pattern.width(s));
+    if (parent[end - 1] != -1) child_supernodes[supernode_of[parent[end - 1]]].push_back(s);
+  }
+  return pattern;
 }
 
 using Panel = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;

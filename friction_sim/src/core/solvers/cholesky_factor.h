@@ -1,6 +1,6 @@
-// The direct method's Cholesky factor: CHOLMOD's ordering and supernodal analysis, the rig's own numeric
-// factorisation (dense blocks by Eigen), and triangular sweeps in double for exact solves and through a
-// single-precision copy for the modified-Newton corrections.
+// The direct method's Cholesky factor: SuiteSparse's AMD ordering, the core's own supernodal analysis and
+// numeric factorisation (dense blocks by Eigen), and triangular sweeps in double for exact solves and
+// through a single-precision copy for the modified-Newton corrections.
 #pragma once
 
 #include <vector>
@@ -35,9 +35,9 @@ class CholeskyFactor {
   template <typename Entry>
   Vector sweep(const std::vector<Entry>& below, const Vector& rhs) const;
 
-  /// The factor's row k belongs to the matrix's row fill_order_[k] (CHOLMOD's fill-reducing permutation).
+  /// The factor's row k belongs to the matrix's row fill_order_[k] (the fill-reducing ordering).
   std::vector<int> fill_order_;
-  /// The factor in blocks of columns that share one pattern below their own diagonal block (CHOLMOD's
+  /// The factor in blocks of columns that share one pattern below their own diagonal block (the
   /// supernodes, cut to kWidestBlock columns), so that a solve reads one list of rows per block and
   /// touches each of those rows once per block, not once per column. Block b spans columns
   /// [first_column_[b], first_column_[b + 1]).

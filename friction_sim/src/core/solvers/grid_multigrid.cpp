@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "solvers/cholesky_factor.h"
+
 namespace friction {
 
 namespace {
@@ -158,12 +160,13 @@ GridMultigrid::GridMultigrid(SparseMatrix matrix, const std::vector<int>& free_d
     dofs.swap(coarse_dofs);
     grid = coarse;
   }
-  coarsest_.compute(matrix);
-  if (coarsest_.info() != Eigen::Success) throw std::runtime_error("multigrid: the coarsest matrix is singular");
+  coarsest_ = std::make_unique<CholeskyFactor>(SparseMatrix(matrix.triangularView<Eigen::Lower>()));
 }
 
+GridMultigrid::~GridMultigrid() = default;
+
 Vector GridMultigrid::cycle(std::size_t level, const Vector& rhs) const {
-  if (level == levels_.size()) return coarsest_.solve(rhs);
+  if (level == levels_.size()) return coarsest_->solve(rhs);
   const Level& here = levels_[level];
   Vector x = Vector::Zero(rhs.size());
   gaussSeidel(here.matrix, here.inverse_diagonal, rhs, x, true);
@@ -178,7 +181,7 @@ Vector GridMultigrid::solve(const Vector& rhs, double relative_tolerance) const 
   Vector x = Vector::Zero(rhs.size());
   const double target = relative_tolerance * rhs.norm();
   if (target == 0.0) return x;
-  if (levels_.empty()) return coarsest_.solve(rhs);
+  if (levels_.empty()) return coarsest_->solve(rhs);
   const SparseMatrix& matrix = levels_.front().matrix;
   Vector residual = rhs;
   Vector preconditioned = cycle(0, residual);

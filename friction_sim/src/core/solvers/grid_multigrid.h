@@ -3,12 +3,14 @@
 // factor grows as n log n: 2.2 GB for 10⁶ nodes, against a few matrix copies here).
 #pragma once
 
-#include <Eigen/CholmodSupport>
+#include <memory>
 #include <vector>
 
 #include "friction_sim/model/model.h"
 
 namespace friction {
+
+class CholeskyFactor;
 
 /// Layout of a structured grid's degrees of freedom: component c of node (i, j) is dof
 /// c·nodes_x·nodes_z + j·nodes_x + i (the lattice: u_x of every node, then u_z; the chain: one row).
@@ -25,6 +27,7 @@ class GridMultigrid {
   /// take every other node along each axis (plus the last), with bilinear interpolation and Galerkin
   /// coarse matrices, down to about a thousand degrees of freedom, which are factored.
   GridMultigrid(SparseMatrix matrix, const std::vector<int>& free_dofs, const GridLayout& layout);
+  ~GridMultigrid();
 
   /// Solves matrix·x = rhs until ‖rhs − matrix·x‖ ≤ relative_tolerance·‖rhs‖. Throws
   /// std::runtime_error if that is not reached within 500 iterations.
@@ -41,7 +44,7 @@ class GridMultigrid {
   Vector cycle(std::size_t level, const Vector& rhs) const;
 
   std::vector<Level> levels_;  ///< finest first; the coarsest matrix is in coarsest_
-  Eigen::CholmodSupernodalLLT<SparseMatrix> coarsest_;
+  std::unique_ptr<CholeskyFactor> coarsest_;
   mutable int last_iterations_ = 0;
 };
 
