@@ -50,8 +50,27 @@ SparseMatrix tridiagonal(int n) {
   return lowerOf(n, entries);
 }
 
+/// A random sparse pattern (about `per_column` entries below the diagonal in each column) made
+/// diagonally dominant, in `components` uncoupled blocks: an elimination forest of irregular trees.
+SparseMatrix randomSparse(int size, int per_column, int components) {
+  std::srand(11);
+  std::vector<Eigen::Triplet<double>> entries;
+  const int block = size / components;
+  for (int c = 0; c < size; ++c) {
+    const int block_end = std::min(size, (c / block + 1) * block);
+    entries.emplace_back(c, c, 2.0 * per_column + 1.0);
+    for (int k = 0; k < per_column && c + 1 < block_end; ++k) {
+      entries.emplace_back(c + 1 + std::rand() % (block_end - c - 1), c, -1.0 + 0.5 * (std::rand() % 3));
+    }
+  }
+  SparseMatrix lower = lowerOf(size, entries);  // repeated entries summed; off-diagonal sums stay small
+  for (int c = 0; c < size; ++c) lower.coeffRef(c, c) += lower.col(c).cwiseAbs().sum() + lower.row(c).cwiseAbs().sum();
+  return lower;
+}
+
 TEST(CholeskyFactor, SinglePrecisionSolveMatchesTheDoubleSolve) {
-  for (const SparseMatrix& lower : {gridLaplacian(70, 1e-3), denseMatrix(45), tridiagonal(500)}) {
+  for (const SparseMatrix& lower :
+       {gridLaplacian(70, 1e-3), denseMatrix(45), tridiagonal(500), randomSparse(900, 3, 4)}) {
     const CholeskyFactor factor(lower);
     const SparseMatrix matrix = lower.selfadjointView<Eigen::Lower>();
     std::srand(7);
