@@ -31,6 +31,10 @@ from sweep import ROOT, RUNNER as RUN, first_global, precursors  # noqa: E402
 BENCH = os.path.join(ROOT, ".build/devel/lib/friction_sim/bench_kernels")
 SCENE = os.path.join(ROOT, "friction_sim/scenes/pmma_2d.yaml")
 OUT = os.path.join(ROOT, ".build/perf")
+REPORT = os.path.join(ROOT, "docs/PERFORMANCE.md")
+# The section scripts/perf_side_by_side.py writes (this build against the one before, as ratios): kept
+# when this script rewrites the rest of the report.
+SIDE_BY_SIDE = ("<!-- side by side: written by scripts/perf_side_by_side.py -->", "<!-- side by side: end -->")
 # The geometric lattices ("nx/nz") of bench_kernels' latticeStep from 10³ to 10⁶ nodes whose runs of
 # nx − 1 bonds are whole 8-wide vectors, as in every lattice the scenes use (57, 113, 225, 449 and 1401
 # wide): their costs tell how the step scales with the number of nodes. A run's left-over bonds cost
@@ -290,8 +294,9 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
              "full-dynamics run at 10 µm/s and 4 the 449 × 241 lattice, and 21 on a faster host of this kind; "
              "finished runs and the kernels' benchmark results in `.build/perf/` are reused, delete it to start "
              "afresh).", "",
-             "Changes since are measured side by side against the build before them, in one sitting on one host, "
-             "by `scripts/perf_side_by_side.py` in [benchmarks/side_by_side.md](benchmarks/side_by_side.md).", "",
+             "Every change of speed is measured side by side against the build before it, in one sitting on one "
+             "host, by `scripts/perf_side_by_side.py`: [the first section](#this-build-against-the-one-before-side-by-side).",
+             "", side_by_side_section(), "",
              "## The machine", "",
              "- %s, %s; %d cores; every run on one thread but the threads table's" % (platform.processor() or platform.machine(),
                                                                            cpu_model(), os.cpu_count()),
@@ -410,7 +415,25 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
               "instead of dividing by m) changes it in the same way. Results of the chain beyond that point are "
               "statistical, not exact; the 2D lattice's default run is not sensitive in this way (the kernel "
               "rewrite left its events unchanged to the printed digits)."]
-    open(os.path.join(ROOT, "docs/PERFORMANCE.md"), "w").write("\n".join(lines) + "\n")
+    open(REPORT, "w").write("\n".join(lines) + "\n")
+
+
+def side_by_side_section():
+    """The side-by-side section of the report as it stands, markers included."""
+    text = open(REPORT).read() if os.path.exists(REPORT) else ""
+    begin, end = text.find(SIDE_BY_SIDE[0]), text.find(SIDE_BY_SIDE[1])
+    if begin < 0 or end < 0:
+        return "%s\n(not measured yet: run scripts/perf_side_by_side.py)\n%s" % SIDE_BY_SIDE
+    return text[begin:end + len(SIDE_BY_SIDE[1])]
+
+
+def replace_side_by_side_section(section):
+    """Writes `section` (without markers) into the report in place of the side-by-side section."""
+    old = side_by_side_section()
+    text = open(REPORT).read()
+    if old not in text:
+        sys.exit("%s has no side-by-side section: regenerate it with scripts/perf_report.py" % REPORT)
+    open(REPORT, "w").write(text.replace(old, "%s\n%s\n%s" % (SIDE_BY_SIDE[0], section, SIDE_BY_SIDE[1])))
 
 
 def targets_section(median, repetitions, whole):
