@@ -139,14 +139,24 @@ std::unique_ptr<EventStream> stressesStream(std::ostream& out, const EventStream
       });
 }
 
+namespace {
+/// Opens `path` as a new file. An earlier run's file is removed, not truncated: ext4 writes a truncated
+/// file back to disk as it is closed (auto_da_alloc), which cost a 57 × 31 run 1.4 ms of its 17.
+void openAnew(std::ofstream& file, const std::string& path) {
+  std::error_code ignored;  // a file that cannot be removed fails to open, which the caller checks
+  std::filesystem::remove(path, ignored);
+  file.open(path);
+}
+}  // namespace
+
 ResultsFolder::ResultsFolder(const std::string& directory) : directory_(directory) {
   std::error_code error;
   std::filesystem::create_directories(directory, error);
   if (error) throw std::runtime_error("cannot create the directory (" + error.message() + ")");
-  events_.open(directory + "/events.csv");
-  event_nodes_.open(directory + "/event_nodes.csv");
-  loading_.open(directory + "/loading.csv");
-  stresses_.open(directory + "/stresses.csv");
+  openAnew(events_, directory + "/events.csv");
+  openAnew(event_nodes_, directory + "/event_nodes.csv");
+  openAnew(loading_, directory + "/loading.csv");
+  openAnew(stresses_, directory + "/stresses.csv");
   if (!events_ || !event_nodes_ || !loading_ || !stresses_) throw std::runtime_error("cannot create files in it");
   writeEventsHeader(events_);
   writeEventNodesHeader(event_nodes_);
@@ -168,7 +178,9 @@ void ResultsFolder::addStreams(RunDriver& driver, const EventStream::Ended& ende
 }
 
 bool ResultsFolder::finish(const Simulation& simulation, double wall_time, std::ostream& console) {
-  std::ofstream scene_yaml(directory_ + "/scene.yaml"), summary_txt(directory_ + "/summary.txt");
+  std::ofstream scene_yaml, summary_txt;
+  openAnew(scene_yaml, directory_ + "/scene.yaml");
+  openAnew(summary_txt, directory_ + "/summary.txt");
   scene_yaml << sceneToYaml(simulation.scene());
   const RunSummary summary = summarize(simulation, wall_time);
   printSummary(summary_txt, summary);
