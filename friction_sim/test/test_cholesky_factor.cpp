@@ -40,7 +40,7 @@ SparseMatrix denseMatrix(int n) {
   return lowerOf(n, entries);
 }
 
-/// A tridiagonal matrix: every supernode one column wide.
+/// A tridiagonal matrix: every fundamental supernode one column wide, relaxed into runs of up to 16.
 SparseMatrix tridiagonal(int n) {
   std::vector<Eigen::Triplet<double>> entries;
   for (int i = 0; i < n; ++i) {
@@ -83,6 +83,13 @@ TEST(CholeskyFactor, SinglePrecisionSolveMatchesTheDoubleSolve) {
     EXPECT_LT((single - exact).norm(), 1e-6 * exact.norm()) << lower.rows();
     EXPECT_GT((single - exact).norm(), 0.0) << lower.rows();  // it is the single-precision copy
   }
+}
+
+TEST(CholeskyFactor, SolvesWithoutUnknowns) {
+  // Nothing to solve for: an empty factor, not an error (AMD itself refuses empty arrays).
+  const CholeskyFactor factor(SparseMatrix(0, 0));
+  EXPECT_EQ(factor.solve(Vector()).size(), 0);
+  EXPECT_EQ(factor.solveSinglePrecision(Vector()).size(), 0);
 }
 
 TEST(CholeskyFactor, RefusesASingularMatrix) {

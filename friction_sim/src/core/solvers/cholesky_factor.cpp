@@ -163,13 +163,19 @@ std::vector<int> postorder(const std::vector<int>& parent, const std::vector<int
   return order;
 }
 
-/// The factor's pattern: its fill-reducing ordering (SuiteSparse's AMD, then the elimination tree's
-/// postorder) and its supernodes, runs of columns stored together as one dense column-major panel.
-/// Relaxed as CHOLMOD relaxes them: a few explicit zeros buy wider panels, whose updates are dense
-/// matrix products.
-struct SupernodalPattern {
+/// What the numeric factorisation needs: the fill-reducing ordering (SuiteSparse's AMD, then the
+/// elimination tree's postorder), the matrix in that order, and the factor's supernodes, runs of
+/// columns stored together as one dense column-major panel. Relaxed as CHOLMOD relaxes them: a few
+/// explicit zeros buy wider panels, whose updates are dense matrix products. Every solve reads the zeros
+/// too (at 57 × 31 the panels hold 16 % more entries than the fundamental supernodes would): without
+/// relaxation a 225 × 121 run to the first global event read 1.05× as fast in one sitting of three
+/// rounds, within the host's noise, and the creeping rate-and-state slider's late precursors, which
+/// move with round-off, left their test's tolerance (2026-11-27, AMD EPYC family 25).
+struct Analysis {
   std::vector<int> fill_order;    ///< the factor's row k is the matrix's row fill_order[k]
+  PermutedLower matrix;           ///< the lower triangle in that order
   std::vector<int> first_column;  ///< supernode s spans columns [first_column[s], first_column[s + 1])
+  std::vector<int> supernode_of;  ///< each column's supernode
   std::vector<int> rows_start;    ///< its rows rows[rows_start[s] ...], its own columns first
   std::vector<int> rows;
   std::vector<std::size_t> panel_start;  ///< its panel, rows × columns, from panel_start[s]
@@ -186,9 +192,13 @@ bool relaxedEnough(int columns, double zeros, double entries) {
   return columns <= 4 || (columns <= 16 && fraction < 0.8) || (columns <= 48 && fraction < 0.1) || fraction < 0.05;
 }
 
-SupernodalPattern analyse(const SparseMatrix& lower) {
+Analysis analyse(const SparseMatrix& lower) {
   const int n = static_cast<int>(lower.rows());
-  SupernodalPattern pattern;
+  Analysis analysis;
+  analysis.first_column = {0};
+  analysis.rows_start = {0};
+  analysis.panel_start = {0};
+  if (n == 0) return analysis;  // amd_order refuses empty arrays
   std::vector<int> minimum_degree(n);
   {
     const SparseMatrix compressed = lower.isCompressed() ? SparseMatrix() : SparseMatrix(lower);
@@ -201,72 +211,69 @@ SupernodalPattern analyse(const SparseMatrix& lower) {
       throw std::runtime_error("static solve: AMD could not order the stiffness matrix");
     }
   }
-  const Pattern above = aboveDiagonal(permute(lower, minimum_degree));
-  const std::vector<int> tree_parent = eliminationTree(above);
-  const std::vector<int> tree_count = columnCounts(above, tree_parent);
+  const Pattern above_in_amd_order = aboveDiagonal(permute(lower, minimum_degree));
+  const std::vector<int> tree_parent = eliminationTree(above_in_amd_order);
+  const std::vector<int> tree_count = columnCounts(above_in_amd_order, tree_parent);
   const std::vector<int> post = postorder(tree_parent, tree_count);
-  // The tree and the counts relabelled in postorder.
   std::vector<int> position(n), parent(n), count(n), children(n, 0);
   for (int k = 0; k < n; ++k) position[post[k]] = k;
-  pattern.fill_order.resize(n);
+  analysis.fill_order.resize(n);
   for (int k = 0; k < n; ++k) {
-    pattern.fill_order[k] = minimum_degree[post[k]];
+    analysis.fill_order[k] = minimum_degree[post[k]];
     parent[k] = tree_parent[post[k]] == -1 ? -1 : position[tree_parent[post[k]]];
     count[k] = tree_count[post[k]];
     if (parent[k] != -1) ++children[parent[k]];
   }
-  // Fundamental supernodes: a column continues the one before when that is its only child and its
-  // pattern is the child's without it.
-  struct Group {
-    int first, columns, height;  ///< height: the first column's rows, its own columns included
-    double zeros;                ///< explicit zeros
+  analysis.matrix = permute(lower, analysis.fill_order);
+  // Fundamental supernodes: a column continues the one before when that column is its only child and
+  // its pattern is the child's without it.
+  struct Run {
+    int first, columns;
+    int height;    ///< rows of its first column, its own columns included
+    double zeros;  ///< explicit zeros
   };
-  std::vector<Group> fundamental;
+  std::vector<Run> fundamental;
   for (int first = 0; first < n;) {
     int end = first + 1;
     while (end < n && parent[end - 1] == end && children[end] == 1 && count[end] == count[end - 1] - 1) ++end;
     fundamental.push_back({first, end - first, count[first], 0.0});
     first = end;
   }
-  // Relaxed from the root down: a fundamental supernode whose parent's first column follows its last
-  // (its parent's last child) joins the group that parent is in while relaxedEnough.
+  // Relaxed from the root down: a fundamental supernode whose last column's parent is the next column
+  // (it is its parent's last child) joins the supernode that parent is in while relaxedEnough. The
+  // child's rows below its columns lie in its parent's pattern, so the merged first column's rows are
+  // the child's columns and the parent supernode's first column's rows.
   const auto entries = [](int columns, int height) {
     return static_cast<double>(columns) * height - 0.5 * static_cast<double>(columns) * (columns - 1);
   };
-  std::vector<Group> groups;  // from the top down
-  for (int f = static_cast<int>(fundamental.size()) - 1; f >= 0; --f) {
-    const Group& child = fundamental[f];
-    const int last = child.first + child.columns - 1;
-    if (!groups.empty() && parent[last] == last + 1) {
-      Group& above = groups.back();
-      const Group merged{child.first, child.columns + above.columns, child.columns + above.height,
-                         above.zeros + entries(child.columns + above.columns, child.columns + above.height) -
-                             entries(child.columns, child.height) - entries(above.columns, above.height)};
+  std::vector<Run> relaxed;  // from the root down
+  for (auto child = fundamental.rbegin(); child != fundamental.rend(); ++child) {
+    const int last = child->first + child->columns - 1;
+    if (!relaxed.empty() && parent[last] == last + 1) {
+      Run& parent_run = relaxed.back();
+      const Run merged{child->first, child->columns + parent_run.columns, child->columns + parent_run.height,
+                       parent_run.zeros +
+                           entries(child->columns + parent_run.columns, child->columns + parent_run.height) -
+                           entries(child->columns, child->height) - entries(parent_run.columns, parent_run.height)};
       if (relaxedEnough(merged.columns, merged.zeros, entries(merged.columns, merged.height))) {
-        above = merged;
+        parent_run = merged;
         continue;
       }
     }
-    groups.push_back(child);
+    relaxed.push_back(*child);
   }
-  std::reverse(groups.begin(), groups.end());
-  // Each supernode's rows: its own columns, then the rows below them of its matrix columns and of its
-  // children's patterns.
-  const int supernodes = static_cast<int>(groups.size());
-  std::vector<int> supernode_of(n);
-  pattern.first_column = {0};
-  pattern.rows_start = {0};
-  pattern.panel_start = {0};
-  for (int s = 0; s < supernodes; ++s) {
-    std::fill(supernode_of.begin() + groups[s].first, supernode_of.begin() + groups[s].first + groups[s].columns, s);
-    pattern.first_column.push_back(groups[s].first + groups[s].columns);
+  analysis.supernode_of.resize(n);
+  for (auto run = relaxed.rbegin(); run != relaxed.rend(); ++run) {
+    std::fill(analysis.supernode_of.begin() + run->first, analysis.supernode_of.begin() + run->first + run->columns,
+              analysis.supernodes());
+    analysis.first_column.push_back(run->first + run->columns);
   }
-  std::vector<std::vector<int>> child_supernodes(supernodes);
-  std::vector<int> below;
-  const PermutedLower matrix = permute(lower, pattern.fill_order);
-  std::vector<int> mark(n, -1);
+  // A supernode's rows below its columns are those of its matrix columns and of its children's
+  // patterns (the children listed from first_child through next_child).
+  const int supernodes = analysis.supernodes();
+  std::vector<int> first_child(supernodes, -1), next_child(supernodes, -1), mark(n, -1), below;
   for (int s = 0; s < supernodes; ++s) {
-    const int first = pattern.first_column[s], end = pattern.first_column[s + 1];
+    const int first = analysis.first_column[s], end = analysis.first_column[s + 1];
     below.clear();
     const auto add = [&](int row) {
       if (row >= end && mark[row] != s) {
@@ -274,54 +281,52 @@ SupernodalPattern analyse(const SparseMatrix& lower) {
         below.push_back(row);
       }
     };
-    for (int k = first; k < end; ++k) {
-      for (int at = matrix.start[k]; at < matrix.start[k + 1]; ++at) add(matrix.rows[at]);
-    }
-    for (int child : child_supernodes[s]) {
-      for (int at = pattern.rows_start[child]; at < pattern.rows_start[child + 1]; ++at) add(pattern.rows[at]);
+    for (int at = analysis.matrix.start[first]; at < analysis.matrix.start[end]; ++at) add(analysis.matrix.rows[at]);
+    for (int child = first_child[s]; child != -1; child = next_child[child]) {
+      for (int at = analysis.rows_start[child]; at < analysis.rows_start[child + 1]; ++at) add(analysis.rows[at]);
     }
     std::sort(below.begin(), below.end());
-    for (int k = first; k < end; ++k) pattern.rows.push_back(k);
-    pattern.rows.insert(pattern.rows.end(), below.begin(), below.end());
-    pattern.rows_start.push_back(static_cast<int>(pattern.rows.size()));
-    pattern.panel_start.push_back(pattern.panel_start.back() +
-                                  static_cast<std::size_t>(pattern.height(s)) * pattern.width(s));
-    if (parent[end - 1] != -1) child_supernodes[supernode_of[parent[end - 1]]].push_back(s);
+    for (int k = first; k < end; ++k) analysis.rows.push_back(k);
+    analysis.rows.insert(analysis.rows.end(), below.begin(), below.end());
+    analysis.rows_start.push_back(static_cast<int>(analysis.rows.size()));
+    analysis.panel_start.push_back(analysis.panel_start.back() +
+                                   static_cast<std::size_t>(analysis.height(s)) * analysis.width(s));
+    if (parent[end - 1] != -1) {
+      const int parent_supernode = analysis.supernode_of[parent[end - 1]];
+      next_child[s] = first_child[parent_supernode];
+      first_child[parent_supernode] = s;
+    }
   }
-  return pattern;
+  return analysis;
 }
 
-using Panel = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+using Panel = Eigen::Map<Eigen::MatrixXd>;
 
 /// The numeric factorisation, left-looking by supernodes: each supernode's panel gathers the matrix's
 /// columns, subtracts the updates of the supernodes below it in the elimination tree that reach its
 /// columns (one dense product each), then factors its diagonal block and solves the rows below it.
 /// Returns the panels.
-std::vector<double> factorise(const SparseMatrix& lower, const SupernodalPattern& pattern) {
-  const int n = static_cast<int>(pattern.fill_order.size()), supernodes = pattern.supernodes();
-  const PermutedLower matrix = permute(lower, pattern.fill_order);
-  std::vector<double> panels(pattern.panel_start[supernodes], 0.0);
-  std::vector<int> supernode_of(n);
-  for (int s = 0; s < supernodes; ++s) {
-    std::fill(supernode_of.begin() + pattern.first_column[s], supernode_of.begin() + pattern.first_column[s + 1], s);
-  }
+std::vector<double> factorise(const Analysis& analysis) {
+  const int n = static_cast<int>(analysis.fill_order.size()), supernodes = analysis.supernodes();
+  const PermutedLower& matrix = analysis.matrix;
+  std::vector<double> panels(analysis.panel_start[supernodes], 0.0);
   // Supernodes waiting to update supernode s: a list from pending[s] through next_pending; each knows
   // where its rows reach s's columns (reached[d]).
   std::vector<int> pending(supernodes, -1), next_pending(supernodes, -1), reached(supernodes, 0);
   const auto enqueue = [&](int d, int row_position) {
     reached[d] = row_position;
-    if (row_position == pattern.height(d)) return;
-    const int target = supernode_of[pattern.rows[pattern.rows_start[d] + row_position]];
+    if (row_position == analysis.height(d)) return;
+    const int target = analysis.supernode_of[analysis.rows[analysis.rows_start[d] + row_position]];
     next_pending[d] = pending[target];
     pending[target] = d;
   };
   std::vector<int> row_in_panel(n), target_rows;
   Eigen::MatrixXd update;
   for (int s = 0; s < supernodes; ++s) {
-    const int first = pattern.first_column[s], end = pattern.first_column[s + 1], width = end - first;
-    const int height = pattern.height(s);
-    const int* rows = pattern.rows.data() + pattern.rows_start[s];
-    Panel panel(panels.data() + pattern.panel_start[s], height, width, Eigen::OuterStride<>(height));
+    const int first = analysis.first_column[s], end = analysis.first_column[s + 1], width = end - first;
+    const int height = analysis.height(s);
+    const int* rows = analysis.rows.data() + analysis.rows_start[s];
+    Panel panel(panels.data() + analysis.panel_start[s], height, width);
     for (int r = 0; r < height; ++r) row_in_panel[rows[r]] = r;
     for (int k = first; k < end; ++k) {
       for (int at = matrix.start[k]; at < matrix.start[k + 1]; ++at) {
@@ -330,13 +335,12 @@ std::vector<double> factorise(const SparseMatrix& lower, const SupernodalPattern
     }
     for (int d = pending[s]; d != -1;) {
       const int after = next_pending[d];
-      const int d_height = pattern.height(d);
-      const int* d_rows = pattern.rows.data() + pattern.rows_start[d];
+      const int d_height = analysis.height(d);
+      const int* d_rows = analysis.rows.data() + analysis.rows_start[d];
       const int top = reached[d];
       int inside = top;
       while (inside < d_height && d_rows[inside] < end) ++inside;
-      const Panel d_panel(panels.data() + pattern.panel_start[d], d_height, pattern.width(d),
-                          Eigen::OuterStride<>(d_height));
+      const Panel d_panel(panels.data() + analysis.panel_start[d], d_height, analysis.width(d));
       const int below = d_height - top, across = inside - top;
       update.noalias() = d_panel.middleRows(top, below) * d_panel.middleRows(top, across).transpose();
       target_rows.resize(below);
@@ -362,20 +366,20 @@ std::vector<double> factorise(const SparseMatrix& lower, const SupernodalPattern
 }  // namespace
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) {
-  const SupernodalPattern pattern = analyse(lower);
-  std::vector<double> panels = factorise(lower, pattern);
-  fill_order_ = pattern.fill_order;
+  const Analysis analysis = analyse(lower);
+  std::vector<double> panels = factorise(analysis);
+  fill_order_ = analysis.fill_order;
   // Each supernode in blocks of at most kWidestBlock columns; a block's rows below its diagonal block
   // are the rest of its supernode's columns and the supernode's rows below them.
   first_column_ = {0};
   diagonal_start_ = {0};
   rows_start_ = {0};
   below_start_ = {0};
-  for (int s = 0; s < pattern.supernodes(); ++s) {
-    const int first = pattern.first_column[s], end = pattern.first_column[s + 1];
+  for (int s = 0; s < analysis.supernodes(); ++s) {
+    const int first = analysis.first_column[s], end = analysis.first_column[s + 1];
     for (int block_first = first; block_first < end; block_first += kWidestBlock) {
       const int block_end = std::min(block_first + kWidestBlock, end), width = block_end - block_first;
-      const int below_count = pattern.height(s) - (block_end - first);
+      const int below_count = analysis.height(s) - (block_end - first);
       first_column_.push_back(block_end);
       diagonal_start_.push_back(diagonal_start_.back() + width * width);
       rows_start_.push_back(rows_start_.back() + below_count);
@@ -387,11 +391,11 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) {
   rows_.resize(rows_start_.back());
   below_.resize(below_start_.back());
   std::size_t block = 0;
-  for (int s = 0; s < pattern.supernodes(); ++s) {
-    const int first = pattern.first_column[s], height = pattern.height(s);
-    const int* rows = pattern.rows.data() + pattern.rows_start[s];
-    const double* panel = panels.data() + pattern.panel_start[s];
-    for (; block + 1 < first_column_.size() && first_column_[block] < pattern.first_column[s + 1]; ++block) {
+  for (int s = 0; s < analysis.supernodes(); ++s) {
+    const int first = analysis.first_column[s], height = analysis.height(s);
+    const int* rows = analysis.rows.data() + analysis.rows_start[s];
+    const double* panel = panels.data() + analysis.panel_start[s];
+    for (; block + 1 < first_column_.size() && first_column_[block] < analysis.first_column[s + 1]; ++block) {
       const int offset = first_column_[block] - first, width = first_column_[block + 1] - first_column_[block];
       for (int c = 0; c < width; ++c) {
         for (int r = c; r < width; ++r) {

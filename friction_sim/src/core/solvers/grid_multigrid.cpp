@@ -160,7 +160,11 @@ GridMultigrid::GridMultigrid(SparseMatrix matrix, const std::vector<int>& free_d
     dofs.swap(coarse_dofs);
     grid = coarse;
   }
-  coarsest_ = std::make_unique<CholeskyFactor>(SparseMatrix(matrix.triangularView<Eigen::Lower>()));
+  try {
+    coarsest_ = std::make_unique<CholeskyFactor>(SparseMatrix(matrix.triangularView<Eigen::Lower>()));
+  } catch (const std::runtime_error&) {
+    throw std::runtime_error("multigrid: the coarsest matrix is singular");
+  }
 }
 
 GridMultigrid::~GridMultigrid() = default;
