@@ -167,10 +167,9 @@ std::vector<int> postorder(const std::vector<int>& parent, const std::vector<int
 /// elimination tree's postorder), the matrix in that order, and the factor's supernodes, runs of
 /// columns stored together as one dense column-major panel. Relaxed as CHOLMOD relaxes them: a few
 /// explicit zeros buy wider panels, whose updates are dense matrix products. Every solve reads the zeros
-/// too (at 57 × 31 the panels hold 16 % more entries than the fundamental supernodes would): without
-/// relaxation a 225 × 121 run to the first global event read 1.05× as fast in one sitting of three
-/// rounds, within the host's noise, and the creeping rate-and-state slider's late precursors, which
-/// move with round-off, left their test's tolerance (2026-11-27, AMD EPYC family 25).
+/// too (at 57 × 31 the panels hold 16 % more entries than the fundamental supernodes would), but solves
+/// swept over the fundamental supernodes left a 225 × 121 run to the first global event as fast (9.04
+/// against 9.05 s, 4 interleaved rounds, 2026-11-27, AMD EPYC family 25).
 struct Analysis {
   std::vector<int> fill_order;    ///< the factor's row k is the matrix's row fill_order[k]
   PermutedLower matrix;           ///< the lower triangle in that order
