@@ -418,9 +418,10 @@ def write_report(reference, results, slow, slow_full, sizes, bench, whole, sensi
     open(REPORT, "w").write("\n".join(lines) + "\n")
 
 
-def side_by_side_section():
-    """The side-by-side section of the report as it stands, markers included."""
-    text = open(REPORT).read() if os.path.exists(REPORT) else ""
+def side_by_side_section(text=None):
+    """The side-by-side section of the report (`text`, read if not given), markers included."""
+    if text is None:
+        text = open(REPORT).read() if os.path.exists(REPORT) else ""
     begin, end = text.find(SIDE_BY_SIDE[0]), text.find(SIDE_BY_SIDE[1])
     if begin < 0 or end < 0:
         return "%s\n(not measured yet: run scripts/perf_side_by_side.py)\n%s" % SIDE_BY_SIDE
@@ -429,8 +430,8 @@ def side_by_side_section():
 
 def replace_side_by_side_section(section):
     """Writes `section` (without markers) into the report in place of the side-by-side section."""
-    old = side_by_side_section()
     text = open(REPORT).read()
+    old = side_by_side_section(text)
     if old not in text:
         sys.exit("%s has no side-by-side section: regenerate it with scripts/perf_report.py" % REPORT)
     open(REPORT, "w").write(text.replace(old, "%s\n%s\n%s" % (SIDE_BY_SIDE[0], section, SIDE_BY_SIDE[1])))

@@ -41,10 +41,14 @@ EXTRA = 10000
 WHOLE_RUN_SIZES = 3
 
 
+def short_commit(rev):
+    return subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", rev], check=True, capture_output=True,
+                          text=True).stdout.strip()
+
+
 def build_baseline(rev):
     """The friction_run of `rev`, built in its own worktree and catkin workspace."""
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", rev], check=True, capture_output=True,
-                            text=True).stdout.strip()
+    commit = short_commit(rev)
     tree = os.path.join(ROOT, ".build/baseline", commit)
     if not os.path.isdir(tree):
         subprocess.run(["git", "-C", ROOT, "worktree", "add", "--detach", tree, commit], check=True)
@@ -208,8 +212,7 @@ def main():
         events = {tuple(key.split("|")): [tuple(e) for e in value] for key, value in kept["events"].items()}
         write(kept["base"], kept.get("head", "?"), kept["walls"], steps, events, kept["rounds"])
         return
-    head = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], check=True, capture_output=True,
-                          text=True).stdout.strip()
+    head = short_commit("HEAD")
     commit, base_runner = build_baseline(args.base)
     walls, steps, events = measure({"base": base_runner, "this build": RUNNER}, args.rounds)
     with open(MEASURED, "w") as handle:

@@ -34,17 +34,28 @@ int widthOf(FixedWidth, int width) {
   return FixedWidth::value > 0 ? FixedWidth::value : width;
 }
 
-/// The lower triangle of P·A·Pᵀ (A = `lower`'s symmetric matrix, P an ordering) by columns.
-struct PermutedLower {
+/// A pattern by columns: column k's rows are rows[start[k] ... start[k + 1]).
+struct Pattern {
   std::vector<int> start, rows;
+  int size() const { return static_cast<int>(start.size()) - 1; }
+};
+
+/// The lower triangle of P·A·Pᵀ (A = `lower`'s symmetric matrix, P an ordering) by columns.
+struct PermutedLower : Pattern {
   std::vector<double> values;
 };
+
+/// Each index's position in `order`.
+std::vector<int> positionsIn(const std::vector<int>& order) {
+  std::vector<int> position(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) position[order[k]] = static_cast<int>(k);
+  return position;
+}
 
 /// `lower` ordered by `order` (row k of the result is the matrix's row order[k]).
 PermutedLower permute(const SparseMatrix& lower, const std::vector<int>& order) {
   const int n = static_cast<int>(order.size());
-  std::vector<int> position(n);
-  for (int k = 0; k < n; ++k) position[order[k]] = k;
+  const std::vector<int> position = positionsIn(order);
   PermutedLower permuted;
   permuted.start.assign(n + 1, 0);
   for (int j = 0; j < n; ++j) {
@@ -67,27 +78,26 @@ PermutedLower permute(const SparseMatrix& lower, const std::vector<int>& order) 
   return permuted;
 }
 
-/// A pattern by columns: column k's rows are rows[start[k] ... start[k + 1]).
-struct Pattern {
-  std::vector<int> start, rows;
-  int size() const { return static_cast<int>(start.size()) - 1; }
-};
-
-/// The columns above the diagonal of a permuted lower triangle's symmetric matrix: column k lists the
-/// rows i < k with an entry (its row k left of the diagonal), ascending.
-Pattern aboveDiagonal(const PermutedLower& matrix) {
-  const int n = static_cast<int>(matrix.start.size()) - 1;
+/// The columns above the diagonal of `lower`'s symmetric matrix ordered by `order`: column k lists the
+/// rows i < k with an entry (its row k left of the diagonal). Only the pattern: the elimination tree and
+/// the column counts need no values and no order within a column.
+Pattern aboveDiagonal(const SparseMatrix& lower, const std::vector<int>& order) {
+  const int n = static_cast<int>(order.size());
+  const std::vector<int> position = positionsIn(order);
   Pattern above{std::vector<int>(n + 1, 0), {}};
-  for (int c = 0; c < n; ++c) {
-    for (int at = matrix.start[c]; at < matrix.start[c + 1]; ++at)
-      above.start[matrix.rows[at] + 1] += matrix.rows[at] != c;
+  for (int j = 0; j < n; ++j) {
+    for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
+      const int a = position[it.row()], b = position[j];
+      if (a != b) ++above.start[std::max(a, b) + 1];
+    }
   }
-  for (int c = 0; c < n; ++c) above.start[c + 1] += above.start[c];
+  for (int k = 0; k < n; ++k) above.start[k + 1] += above.start[k];
   std::vector<int> next(above.start.begin(), above.start.end() - 1);
   above.rows.resize(above.start[n]);
-  for (int c = 0; c < n; ++c) {
-    for (int at = matrix.start[c]; at < matrix.start[c + 1]; ++at) {
-      if (matrix.rows[at] != c) above.rows[next[matrix.rows[at]]++] = c;
+  for (int j = 0; j < n; ++j) {
+    for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
+      const int a = position[it.row()], b = position[j];
+      if (a != b) above.rows[next[std::max(a, b)]++] = std::min(a, b);
     }
   }
   return above;
@@ -210,12 +220,12 @@ Analysis analyse(const SparseMatrix& lower) {
       throw std::runtime_error("static solve: AMD could not order the stiffness matrix");
     }
   }
-  const Pattern above_in_amd_order = aboveDiagonal(permute(lower, minimum_degree));
+  const Pattern above_in_amd_order = aboveDiagonal(lower, minimum_degree);
   const std::vector<int> tree_parent = eliminationTree(above_in_amd_order);
   const std::vector<int> tree_count = columnCounts(above_in_amd_order, tree_parent);
   const std::vector<int> post = postorder(tree_parent, tree_count);
-  std::vector<int> position(n), parent(n), count(n), children(n, 0);
-  for (int k = 0; k < n; ++k) position[post[k]] = k;
+  const std::vector<int> position = positionsIn(post);
+  std::vector<int> parent(n), count(n), children(n, 0);
   analysis.fill_order.resize(n);
   for (int k = 0; k < n; ++k) {
     analysis.fill_order[k] = minimum_degree[post[k]];
