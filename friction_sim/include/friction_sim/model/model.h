@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "friction_sim/scene/scene.h"
@@ -25,7 +26,36 @@ template <class Fill>
 SparseMatrix assembleSparse(int size, int entries_per_column, Fill&& fill) {
   SparseMatrix matrix(size, size);
   matrix.reserve(Eigen::VectorXi::Constant(size, entries_per_column));
-  fill([&matrix](int row, int col, double value) { matrix.coeffRef(row, col) += value; });
+  const int* start = matrix.outerIndexPtr();
+  int* count = matrix.innerNonZeroPtr();
+  int* rows = matrix.innerIndexPtr();
+  double* values = matrix.valuePtr();
+  fill([&](int row, int col, double value) {
+    const int first = start[col], end = first + count[col];
+    int at = first;
+    while (at < end && rows[at] != row) ++at;
+    if (at == end) {
+      if (count[col] == entries_per_column) throw std::logic_error("assembleSparse: a column has too many entries");
+      rows[at] = row;
+      values[at] = 0.0;
+      ++count[col];
+    }
+    values[at] += value;
+  });
+  for (int col = 0; col < size; ++col) {
+    // Insertion sort: a column holds a few entries.
+    for (int at = start[col] + 1; at < start[col] + count[col]; ++at) {
+      const int row = rows[at];
+      const double value = values[at];
+      int to = at;
+      for (; to > start[col] && rows[to - 1] > row; --to) {
+        rows[to] = rows[to - 1];
+        values[to] = values[to - 1];
+      }
+      rows[to] = row;
+      values[to] = value;
+    }
+  }
   matrix.makeCompressed();
   return matrix;
 }
