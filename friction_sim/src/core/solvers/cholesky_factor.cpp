@@ -376,54 +376,62 @@ std::vector<double> factorise(const Analysis& analysis) {
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) {
   const Analysis analysis = analyse(lower);
-  std::vector<double> panels = factorise(analysis);
+  entries_ = factorise(analysis);
   fill_order_ = analysis.fill_order;
   // Each supernode in blocks of at most kWidestBlock columns; a block's rows below its diagonal block
   // are the rest of its supernode's columns and the supernode's rows below them.
   first_column_ = {0};
-  diagonal_start_ = {0};
   rows_start_ = {0};
-  below_start_ = {0};
+  below_single_start_ = {0};
+  std::size_t written = 0;
   for (int s = 0; s < analysis.supernodes(); ++s) {
     const int first = analysis.first_column[s], end = analysis.first_column[s + 1];
     for (int block_first = first; block_first < end; block_first += kWidestBlock) {
       const int block_end = std::min(block_first + kWidestBlock, end), width = block_end - block_first;
-      const int below_count = analysis.height(s) - (block_end - first);
+      const std::size_t below_count = analysis.height(s) - (block_end - first);
       first_column_.push_back(block_end);
-      diagonal_start_.push_back(diagonal_start_.back() + width * width);
-      rows_start_.push_back(rows_start_.back() + below_count);
-      below_start_.push_back(below_start_.back() + below_count * width);
+      rows_start_.push_back(rows_start_.back() + static_cast<int>(below_count));
+      diagonal_start_.push_back(written);
+      below_start_.push_back(written + static_cast<std::size_t>(width) * width);
+      written = below_start_.back() + below_count * width;
+      below_single_start_.push_back(below_single_start_.back() + below_count * width);
     }
   }
-  // Sized at once: growing by doubling could hold twice the factor while it is copied (hundreds of MB).
-  diagonal_.assign(diagonal_start_.back(), 0.0);
+  // The blocks are written over the panels: a supernode's blocks take no more room than its panel (each
+  // block leaves out the rows above its own columns), so they end before its panel ends, and they read
+  // nothing but that panel, copied aside first. Sized at once: growing by doubling could hold twice
+  // the factor while it is copied (hundreds of MB).
   rows_.resize(rows_start_.back());
-  below_.resize(below_start_.back());
+  below_single_.resize(below_single_start_.back());
+  std::vector<double> panel;
   std::size_t block = 0;
   for (int s = 0; s < analysis.supernodes(); ++s) {
     const int first = analysis.first_column[s], height = analysis.height(s);
     const int* rows = analysis.rows.data() + analysis.rows_start[s];
-    const double* panel = panels.data() + analysis.panel_start[s];
+    const auto panel_begin = entries_.begin() + static_cast<std::ptrdiff_t>(analysis.panel_start[s]);
+    panel.assign(panel_begin, panel_begin + static_cast<std::ptrdiff_t>(height) * analysis.width(s));
     for (; block + 1 < first_column_.size() && first_column_[block] < analysis.first_column[s + 1]; ++block) {
       const int offset = first_column_[block] - first, width = first_column_[block + 1] - first_column_[block];
+      double* diagonal = entries_.data() + diagonal_start_[block];
       for (int c = 0; c < width; ++c) {
-        for (int r = c; r < width; ++r) {
-          diagonal_[diagonal_start_[block] + c * width + r] = panel[(offset + c) * height + offset + r];
-        }
+        for (int r = 0; r < width; ++r)
+          diagonal[c * width + r] = r < c ? 0.0 : panel[(offset + c) * height + offset + r];
       }
       std::copy(rows + offset + width, rows + height, rows_.begin() + rows_start_[block]);
-      double* below = below_.data() + below_start_[block];
+      double* below = entries_.data() + below_start_[block];
+      float* below_single = below_single_.data() + below_single_start_[block];
       for (int r = offset + width; r < height; ++r) {
-        for (int c = 0; c < width; ++c) *below++ = panel[(offset + c) * height + r];
+        for (int c = 0; c < width; ++c)
+          *below_single++ = static_cast<float>(*below++ = panel[(offset + c) * height + r]);
       }
     }
   }
-  panels = std::vector<double>();  // freed before the single-precision copy is made
-  below_single_.assign(below_.begin(), below_.end());
+  entries_.resize(written);
 }
 
 template <typename Entry>
-Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const Vector& rhs) const {
+Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
+                             const Vector& rhs) const {
   const int n = static_cast<int>(fill_order_.size());
   Vector y(n);
   for (int k = 0; k < n; ++k) y[k] = rhs[fill_order_[k]];
@@ -432,7 +440,7 @@ Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const Vect
   double part[kWidestBlock];
   for (int b = 0; b < blocks; ++b) {  // L·y = P·rhs
     const int first = first_column_[b], width = first_column_[b + 1] - first;
-    const double* diagonal = diagonal_.data() + diagonal_start_[b];
+    const double* diagonal = entries_.data() + diagonal_start_[b];
     for (int c = 0; c < width; ++c) part[c] = y[first + c];
     for (int c = 0; c < width; ++c) {
       const double yc = (part[c] /= diagonal[c * width + c]);
@@ -441,7 +449,7 @@ Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const Vect
     }
     forEachWidth(width, [&](auto fixed_width) {
       const int w = widthOf(fixed_width, width);
-      const Entry* below = below_entries.data() + below_start_[b];
+      const Entry* below = below_entries.data() + below_start[b];
       for (int r = rows_start_[b]; r < rows_start_[b + 1]; ++r, below += w) {
         double sum = 0.0;
         for (int c = 0; c < w; ++c) sum += below[c] * part[c];
@@ -454,13 +462,13 @@ Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const Vect
     for (int c = 0; c < width; ++c) part[c] = y[first + c];
     forEachWidth(width, [&](auto fixed_width) {
       const int w = widthOf(fixed_width, width);
-      const Entry* below = below_entries.data() + below_start_[b];
+      const Entry* below = below_entries.data() + below_start[b];
       for (int r = rows_start_[b]; r < rows_start_[b + 1]; ++r, below += w) {
         const double yr = y[rows_[r]];
         for (int c = 0; c < w; ++c) part[c] -= below[c] * yr;
       }
     });
-    const double* diagonal = diagonal_.data() + diagonal_start_[b];
+    const double* diagonal = entries_.data() + diagonal_start_[b];
     for (int c = width - 1; c >= 0; --c) {
       for (int r = c + 1; r < width; ++r) part[c] -= diagonal[c * width + r] * part[r];
       y[first + c] = part[c] /= diagonal[c * width + c];
@@ -471,15 +479,16 @@ Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const Vect
   return solution;
 }
 
-Vector CholeskyFactor::solve(const Vector& rhs) const { return sweep(below_, rhs); }
+Vector CholeskyFactor::solve(const Vector& rhs) const { return sweep(entries_, below_start_, rhs); }
 
-Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const { return sweep(below_single_, rhs); }
+Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
+  return sweep(below_single_, below_single_start_, rhs);
+}
 
 std::size_t CholeskyFactor::bytes() const {
-  return (fill_order_.size() + first_column_.size() + diagonal_start_.size() + rows_start_.size() +
-          below_start_.size() + rows_.size()) *
-             sizeof(int) +
-         (diagonal_.size() + below_.size()) * sizeof(double) + below_single_.size() * sizeof(float);
+  return (fill_order_.size() + first_column_.size() + rows_start_.size() + rows_.size()) * sizeof(int) +
+         (diagonal_start_.size() + below_start_.size() + below_single_start_.size()) * sizeof(std::size_t) +
+         entries_.capacity() * sizeof(double) + below_single_.size() * sizeof(float);
 }
 
 }  // namespace friction

@@ -31,27 +31,30 @@ class CholeskyFactor {
   /// Columns per block of a solve at most (a solve keeps one block's partial sums on the stack).
   static constexpr int kWidestBlock = 32;
 
-  /// L·Lᵀ·x = P·rhs solved with the entries below the diagonal blocks in `below`.
+  /// L·Lᵀ·x = P·rhs solved with the entries below block b's diagonal block read from below_entries from
+  /// below_start[b].
   template <typename Entry>
-  Vector sweep(const std::vector<Entry>& below, const Vector& rhs) const;
+  Vector sweep(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
+               const Vector& rhs) const;
 
   /// The factor's row k belongs to the matrix's row fill_order_[k] (the fill-reducing ordering).
   std::vector<int> fill_order_;
   /// The factor in blocks of columns that share one pattern below their own diagonal block (the
   /// supernodes, cut to kWidestBlock columns), so that a solve reads one list of rows per block and
   /// touches each of those rows once per block, not once per column. Block b spans columns
-  /// [first_column_[b], first_column_[b + 1]).
+  /// [first_column_[b], first_column_[b + 1]); its rows below the diagonal block are
+  /// rows_[rows_start_[b] ...].
   std::vector<int> first_column_;
-  /// Its diagonal block, lower triangle of a w × w column-major square from diagonal_start_[b], in double.
-  std::vector<int> diagonal_start_;
-  std::vector<double> diagonal_;
-  /// Its rows below the diagonal block, rows_[rows_start_[b] ...], and their entries, rows × w row-major
-  /// from below_start_[b], in double and in single precision.
   std::vector<int> rows_start_;
   std::vector<int> rows_;
-  std::vector<int> below_start_;
-  std::vector<double> below_;
+  /// In entries_, block b's diagonal block (lower triangle of a w × w column-major square) from
+  /// diagonal_start_[b] and its entries below it (rows × w row-major) from below_start_[b], in double.
+  std::vector<double> entries_;
+  std::vector<std::size_t> diagonal_start_;
+  std::vector<std::size_t> below_start_;
+  /// The entries below the diagonal blocks in single precision, block b's from below_single_start_[b].
   std::vector<float> below_single_;
+  std::vector<std::size_t> below_single_start_;
 };
 
 }  // namespace friction
