@@ -16,9 +16,8 @@ constexpr double kMultigridTolerance = 1e-10;
 
 /// The stiffness of the free degrees of freedom (`position_in_free` is −1 for a fixed one). The
 /// model's matrix is compacted in place (entries only move towards the front) rather than copied into
-/// a second matrix: a 10⁶-node lattice's stiffness takes 450 MB. The storage is not trimmed to its new
-/// size, which would copy it: the matrix is read once and freed. `lower_only` keeps the lower triangle,
-/// all the factorisation reads.
+/// a second matrix: a 10⁶-node lattice's stiffness takes 450 MB. Trimming the storage to its new size
+/// still reallocates once. `lower_only` keeps the lower triangle, all the factorisation reads.
 SparseMatrix freeStiffness(const Model& model, const std::vector<int>& lifted_nodes,
                            const std::vector<int>& position_in_free, int free_count, bool lower_only) {
   SparseMatrix stiffness = model.stiffnessMatrix();
@@ -47,6 +46,7 @@ SparseMatrix freeStiffness(const Model& model, const std::vector<int>& lifted_no
   stiffness.data().resize(written);
   stiffness.conservativeResize(free_count, free_count);
   stiffness.makeCompressed();
+  if (lower_only) stiffness.data().squeeze();
   return stiffness;
 }
 
