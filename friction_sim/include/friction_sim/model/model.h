@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <array>
 #include <functional>
 #include <memory>
@@ -20,54 +21,55 @@ using Vector = Eigen::VectorXd;
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
 /// A `size` × `size` sparse matrix summed from the entries `fill(add)` passes to add(row, col, value),
-/// at most `entries_per_column` distinct ones per column. Each column's entries go into its own
-/// reserved slots in the order they come, found by a linear search, then are sorted once into the
-/// compressed matrix: coeffRef's search and shift per addition, and the copy that compressing its
-/// storage makes, took a sixth of a small lattice's start-up. Every entry is summed in the order of the
-/// additions, as coeffRef sums it. A triplet list of a 10⁶-node lattice would take several times the
-/// matrix's memory; the slots take about as much as the matrix.
+/// at most `entries_per_column` distinct ones per column. Each column's entries go into its own slots
+/// of the matrix's storage in the order they come, found by a linear search; then each column is sorted
+/// and moved to the front in place. coeffRef's search and shift per addition, and the copy that
+/// compressing its storage makes, took a sixth of a small lattice's start-up. Every entry is summed in the
+/// order of the additions, as coeffRef sums it. The storage keeps the slots' size (a 2D lattice's columns
+/// fill nearly all of theirs); a triplet list of a 10⁶-node lattice would take several times as much.
 template <class Fill>
 SparseMatrix assembleSparse(int size, int entries_per_column, Fill&& fill) {
-  const std::size_t slots = static_cast<std::size_t>(size) * entries_per_column;
-  std::vector<int> count(size, 0);
-  const std::unique_ptr<int[]> slot_rows(new int[slots]);  // not zeroed: only the filled slots are read
-  const std::unique_ptr<double[]> slot_values(new double[slots]);
-  fill([&](int row, int col, double value) {
-    int* rows = slot_rows.get() + static_cast<std::size_t>(col) * entries_per_column;
-    double* values = slot_values.get() + static_cast<std::size_t>(col) * entries_per_column;
-    int at = 0;
-    while (at < count[col] && rows[at] != row) ++at;
-    if (at == count[col]) {
-      if (at == entries_per_column) throw std::logic_error("assembleSparse: a column has too many entries");
-      rows[at] = row;
-      values[at] = 0.0;
-      ++count[col];
-    }
-    values[at] += value;
-  });
   SparseMatrix matrix(size, size);
-  std::size_t entries = 0;
-  for (int col = 0; col < size; ++col) entries += count[col];
-  matrix.resizeNonZeros(static_cast<Eigen::Index>(entries));
+  matrix.resizeNonZeros(static_cast<Eigen::Index>(size) * entries_per_column);
   int* start = matrix.outerIndexPtr();
   int* rows = matrix.innerIndexPtr();
   double* values = matrix.valuePtr();
-  start[0] = 0;
+  std::vector<int> count(size, 0);
+  const auto slot = [entries_per_column](int col) { return static_cast<std::size_t>(col) * entries_per_column; };
+  fill([&](int row, int col, double value) {
+    int* slot_rows = rows + slot(col);
+    int at = 0;
+    while (at < count[col] && slot_rows[at] != row) ++at;
+    if (at == count[col]) {
+      if (at == entries_per_column) throw std::logic_error("assembleSparse: a column has too many entries");
+      slot_rows[at] = row;
+      values[slot(col) + at] = 0.0;
+      ++count[col];
+    }
+    values[slot(col) + at] += value;
+  });
   for (int col = 0; col < size; ++col) {
-    const int* from_rows = slot_rows.get() + static_cast<std::size_t>(col) * entries_per_column;
-    const double* from_values = slot_values.get() + static_cast<std::size_t>(col) * entries_per_column;
-    const int first = start[col];
-    for (int k = 0; k < count[col]; ++k) {  // insertion sort: a column holds a few entries
-      int to = first + k;
-      for (; to > first && rows[to - 1] > from_rows[k]; --to) {
+    // Insertion sort within the slots (a column holds a few entries), then down to the column's start,
+    // never past a later column's slots: each column before it holds no more than its slots.
+    const std::size_t from = slot(col);
+    for (int k = 1; k < count[col]; ++k) {
+      const int row = rows[from + k];
+      const double value = values[from + k];
+      std::size_t to = from + k;
+      for (; to > from && rows[to - 1] > row; --to) {
         rows[to] = rows[to - 1];
         values[to] = values[to - 1];
       }
-      rows[to] = from_rows[k];
-      values[to] = from_values[k];
+      rows[to] = row;
+      values[to] = value;
     }
-    start[col + 1] = first + count[col];
+    if (static_cast<std::size_t>(start[col]) != from) {
+      std::copy(rows + from, rows + from + count[col], rows + start[col]);
+      std::copy(values + from, values + from + count[col], values + start[col]);
+    }
+    start[col + 1] = start[col] + count[col];
   }
+  matrix.data().resize(start[size]);  // no reallocation: the storage keeps its capacity
   return matrix;
 }
 
