@@ -375,15 +375,15 @@ std::vector<double> factorise(const Analysis& analysis) {
 }  // namespace
 
 CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) {
-  const Analysis analysis = analyse(lower);
+  Analysis analysis = analyse(lower);
   entries_ = factorise(analysis);
+  analysis.matrix = PermutedLower();  // freed before the single-precision copy is made
   fill_order_ = analysis.fill_order;
   // Each supernode in blocks of at most kWidestBlock columns; a block's rows below its diagonal block
   // are the rest of its supernode's columns and the supernode's rows below them.
   first_column_ = {0};
   rows_start_ = {0};
-  below_single_start_ = {0};
-  std::size_t written = 0;
+  std::size_t written = 0, written_single = 0;
   for (int s = 0; s < analysis.supernodes(); ++s) {
     const int first = analysis.first_column[s], end = analysis.first_column[s + 1];
     for (int block_first = first; block_first < end; block_first += kWidestBlock) {
@@ -394,15 +394,16 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) {
       diagonal_start_.push_back(written);
       below_start_.push_back(written + static_cast<std::size_t>(width) * width);
       written = below_start_.back() + below_count * width;
-      below_single_start_.push_back(below_single_start_.back() + below_count * width);
+      below_single_start_.push_back(written_single);
+      written_single += below_count * width;
     }
   }
   // The blocks are written over the panels: a supernode's blocks take no more room than its panel (each
   // block leaves out the rows above its own columns), so they end before its panel ends, and they read
-  // nothing but that panel, copied aside first. Sized at once: growing by doubling could hold twice
-  // the factor while it is copied (hundreds of MB).
+  // nothing but that panel, copied aside first. The rows and the single-precision copy are sized at
+  // once: growing by doubling could hold twice them while they are filled (hundreds of MB).
   rows_.resize(rows_start_.back());
-  below_single_.resize(below_single_start_.back());
+  below_single_.resize(written_single);
   std::vector<double> panel;
   std::size_t block = 0;
   for (int s = 0; s < analysis.supernodes(); ++s) {

@@ -43,12 +43,15 @@ class CholeskyFactor {
   /// supernodes, cut to kWidestBlock columns), so that a solve reads one list of rows per block and
   /// touches each of those rows once per block, not once per column. Block b spans columns
   /// [first_column_[b], first_column_[b + 1]); its rows below the diagonal block are
-  /// rows_[rows_start_[b] ...].
+  /// rows_[rows_start_[b] ... rows_start_[b + 1]). These two hold one entry more than there are blocks;
+  /// the entries' starts below hold one per block.
   std::vector<int> first_column_;
   std::vector<int> rows_start_;
   std::vector<int> rows_;
   /// In entries_, block b's diagonal block (lower triangle of a w × w column-major square) from
   /// diagonal_start_[b] and its entries below it (rows × w row-major) from below_start_[b], in double.
+  /// entries_ is the numeric factorisation's storage, its blocks written over its panels: it keeps the
+  /// panels' capacity, a little more than the blocks take (bytes() counts it).
   std::vector<double> entries_;
   std::vector<std::size_t> diagonal_start_;
   std::vector<std::size_t> below_start_;
