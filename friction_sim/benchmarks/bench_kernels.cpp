@@ -1,10 +1,10 @@
 // Google Benchmark of the explicit step, the hot loop: ns per node-step of the 2D lattice and per
 // block-step of the 1D chain, over system sizes, and the memory floor of a lattice step (stateStream,
-// and leapfrogStream for a scheme without stored accelerations), and the divider's floor under the 2D
-// step (bondDividerFloor). Three cases separate causes: the 1001 × 61 lattice has the rows of the
-// 10⁶-node one with a state that fits the last-level cache (row width against memory traffic); 32 × 32
-// and 33 × 31 have 10³ nodes each, but 32 × 32's runs of 31 bonds leave 7 over from whole 8-wide vectors
-// (the other lattices' runs are whole vectors but for one bond); and the 2-block chain's step is almost
+// and leapfrogStream for a scheme without stored accelerations), the divider's floor under the 2D
+// step (bondDividerFloor), and a static solve through the direct factor (staticSolve). Three cases separate causes: the
+// 1001 × 61 lattice has the rows of the 10⁶-node one with a state that fits the last-level cache (row width against
+// memory traffic); 32 × 32 and 33 × 31 have 10³ nodes each, but 32 × 32's runs of 31 bonds leave 7 over from whole
+// 8-wide vectors (the other lattices' runs are whole vectors but for one bond); and the 2-block chain's step is almost
 // all the step's fixed cost.
 // Run: .build/devel/lib/friction_sim/bench_kernels
 #include <benchmark/benchmark.h>
@@ -20,6 +20,7 @@
 #include "friction_sim/run/simulation.h"
 #include "friction_sim/scene/scene_io.h"
 #include "friction_sim/solvers/integrator.h"
+#include "friction_sim/solvers/static_solver.h"
 #include "naive_lattice.h"
 
 namespace friction {
@@ -235,6 +236,19 @@ void bondDividerFloor(benchmark::State& state) {
       nsPerNodeStep(static_cast<double>(nx * nz) * static_cast<double>(state.iterations()));
 }
 BENCHMARK(bondDividerFloor)->Unit(benchmark::kMicrosecond);
+
+/// A static solve through the direct factor in double, as fast-forward makes them: the loading solver of
+/// the default slider's lattice, K⁻¹·f for a force on every free dof (µs per solve).
+void staticSolve(benchmark::State& state) {
+  const int nx = static_cast<int>(state.range(0)), nz = static_cast<int>(state.range(1));
+  const std::unique_ptr<Model> model = buildModel(latticeScene(nx, nz));
+  model->disconnectPusher();
+  const StaticSolver solver(*model, model->blockedDofsDuringLoading());
+  Vector force(model->dofCount());
+  for (Eigen::Index i = 0; i < force.size(); ++i) force[i] = std::sin(0.1 * static_cast<double>(i));
+  for (auto _ : state) benchmark::DoNotOptimize(solver.response(force));
+}
+BENCHMARK(staticSolve)->Args({57, 31})->Args({225, 121})->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace friction
