@@ -40,8 +40,9 @@ struct Pattern {
   int size() const { return static_cast<int>(start.size()) - 1; }
 };
 
-/// The lower triangle of P·A·Pᵀ (A = `lower`'s symmetric matrix, P an ordering) by columns.
-struct PermutedLower : Pattern {
+/// A triangle of P·A·Pᵀ (A = `lower`'s symmetric matrix, P an ordering) by columns, with its values
+/// (none for the upper triangle's shape: see Triangle).
+struct PermutedTriangle : Pattern {
   std::vector<double> values;
 };
 
@@ -52,55 +53,42 @@ std::vector<int> positionsIn(const std::vector<int>& order) {
   return position;
 }
 
-/// `lower` ordered by `order` (row k of the result is the matrix's row order[k]).
-PermutedLower permute(const SparseMatrix& lower, const std::vector<int>& order) {
+/// Which triangle of an ordered matrix permute() gives.
+enum class Triangle {
+  kLower,       ///< each column's rows at or below it, with their values
+  kUpperShape,  ///< each column's rows above it, without values: the elimination tree and the column
+                ///< counts need neither values nor an order within a column
+};
+
+/// `lower`'s symmetric matrix ordered by `order` (row k of the result is the matrix's row order[k]), by
+/// columns of `triangle`.
+PermutedTriangle permute(const SparseMatrix& lower, const std::vector<int>& order, Triangle triangle) {
   const int n = static_cast<int>(order.size());
   const std::vector<int> position = positionsIn(order);
-  PermutedLower permuted;
-  permuted.start.assign(n + 1, 0);
-  for (int j = 0; j < n; ++j) {
-    for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
-      ++permuted.start[std::min(position[it.row()], position[j]) + 1];
+  const bool upper = triangle == Triangle::kUpperShape;
+  // visit(column, row, value) for each entry of the triangle, the matrix's columns in turn.
+  const auto forEachEntry = [&](auto&& visit) {
+    for (int j = 0; j < n; ++j) {
+      for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
+        const int a = position[it.row()], b = position[j];
+        if (upper && a == b) continue;
+        visit(upper ? std::max(a, b) : std::min(a, b), upper ? std::min(a, b) : std::max(a, b), it.value());
+      }
     }
-  }
+  };
+  PermutedTriangle permuted;
+  permuted.start.assign(n + 1, 0);
+  forEachEntry([&](int column, int, double) { ++permuted.start[column + 1]; });
   for (int k = 0; k < n; ++k) permuted.start[k + 1] += permuted.start[k];
   std::vector<int> next(permuted.start.begin(), permuted.start.end() - 1);
   permuted.rows.resize(permuted.start[n]);
-  permuted.values.resize(permuted.start[n]);
-  for (int j = 0; j < n; ++j) {
-    for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
-      const int a = position[it.row()], b = position[j];
-      const int at = next[std::min(a, b)]++;
-      permuted.rows[at] = std::max(a, b);
-      permuted.values[at] = it.value();
-    }
-  }
+  if (!upper) permuted.values.resize(permuted.start[n]);
+  forEachEntry([&](int column, int row, double value) {
+    const int at = next[column]++;
+    permuted.rows[at] = row;
+    if (!upper) permuted.values[at] = value;
+  });
   return permuted;
-}
-
-/// The columns above the diagonal of `lower`'s symmetric matrix ordered by `order`: column k lists the
-/// rows i < k with an entry (its row k left of the diagonal). Only the pattern: the elimination tree and
-/// the column counts need no values and no order within a column.
-Pattern aboveDiagonal(const SparseMatrix& lower, const std::vector<int>& order) {
-  const int n = static_cast<int>(order.size());
-  const std::vector<int> position = positionsIn(order);
-  Pattern above{std::vector<int>(n + 1, 0), {}};
-  for (int j = 0; j < n; ++j) {
-    for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
-      const int a = position[it.row()], b = position[j];
-      if (a != b) ++above.start[std::max(a, b) + 1];
-    }
-  }
-  for (int k = 0; k < n; ++k) above.start[k + 1] += above.start[k];
-  std::vector<int> next(above.start.begin(), above.start.end() - 1);
-  above.rows.resize(above.start[n]);
-  for (int j = 0; j < n; ++j) {
-    for (SparseMatrix::InnerIterator it(lower, j); it; ++it) {
-      const int a = position[it.row()], b = position[j];
-      if (a != b) above.rows[next[std::max(a, b)]++] = std::min(a, b);
-    }
-  }
-  return above;
 }
 
 /// The elimination tree: parent[j] is the first row below j in column j of the factor (−1 at a root).
@@ -182,7 +170,7 @@ std::vector<int> postorder(const std::vector<int>& parent, const std::vector<int
 /// against 9.05 s, 4 interleaved rounds, 2026-11-27, AMD EPYC family 25).
 struct Analysis {
   std::vector<int> fill_order;    ///< the factor's row k is the matrix's row fill_order[k]
-  PermutedLower matrix;           ///< the lower triangle in that order
+  PermutedTriangle matrix;        ///< the lower triangle in that order
   std::vector<int> first_column;  ///< supernode s spans columns [first_column[s], first_column[s + 1])
   std::vector<int> supernode_of;  ///< each column's supernode
   std::vector<int> rows_start;    ///< its rows rows[rows_start[s] ...], its own columns first
@@ -220,7 +208,7 @@ Analysis analyse(const SparseMatrix& lower) {
       throw std::runtime_error("static solve: AMD could not order the stiffness matrix");
     }
   }
-  const Pattern above_in_amd_order = aboveDiagonal(lower, minimum_degree);
+  const PermutedTriangle above_in_amd_order = permute(lower, minimum_degree, Triangle::kUpperShape);
   const std::vector<int> tree_parent = eliminationTree(above_in_amd_order);
   const std::vector<int> tree_count = columnCounts(above_in_amd_order, tree_parent);
   const std::vector<int> post = postorder(tree_parent, tree_count);
@@ -233,7 +221,7 @@ Analysis analyse(const SparseMatrix& lower) {
     count[k] = tree_count[post[k]];
     if (parent[k] != -1) ++children[parent[k]];
   }
-  analysis.matrix = permute(lower, analysis.fill_order);
+  analysis.matrix = permute(lower, analysis.fill_order, Triangle::kLower);
   // Fundamental supernodes: a column continues the one before when that column is its only child and
   // its pattern is the child's without it.
   struct Run {
@@ -317,7 +305,7 @@ using Panel = Eigen::Map<Eigen::MatrixXd>;
 /// Returns the panels.
 std::vector<double> factorise(const Analysis& analysis) {
   const int n = static_cast<int>(analysis.fill_order.size()), supernodes = analysis.supernodes();
-  const PermutedLower& matrix = analysis.matrix;
+  const PermutedTriangle& matrix = analysis.matrix;
   std::vector<double> panels(analysis.panel_start[supernodes], 0.0);
   // Supernodes waiting to update supernode s: a list from pending[s] through next_pending; each knows
   // where its rows reach s's columns (reached[d]).
@@ -377,7 +365,7 @@ std::vector<double> factorise(const Analysis& analysis) {
 CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) {
   Analysis analysis = analyse(lower);
   entries_ = factorise(analysis);
-  analysis.matrix = PermutedLower();  // freed before the single-precision copy is made
+  analysis.matrix = PermutedTriangle();  // freed before the single-precision copy is made
   fill_order_ = analysis.fill_order;
   // Each supernode in blocks of at most kWidestBlock columns; a block's rows below its diagonal block
   // are the rest of its supernode's columns and the supernode's rows below them.
