@@ -41,6 +41,8 @@ EXTRA = 10000
 WHOLE_RUN_SIZES = 3
 # Runs per round of a start-up case: the small ones take milliseconds, and the host's noise is as large.
 STARTUP_REPEATS = 7
+# The name of a start-up case (a run that stops at once) begins with this.
+STARTUP = "start-up "
 
 
 def short_commit(rev):
@@ -72,7 +74,7 @@ def cases():
     for index, (nx, nz, dt) in enumerate(SIZES):
         size = {"lattice.nodes_x": nx, "lattice.nodes_z": nz, "integrator.time_step": dt}
         label = "%d × %d" % (nx, nz)
-        listed.append(("start-up " + label, dict(size, **{"stop.time": "1e-9"}), 1))
+        listed.append((STARTUP + label, dict(size, **{"stop.time": "1e-9"}), 1))
         for steps in (STEPPED, STEPPED + EXTRA):
             full = dict(size, **{"integrator.fast_forward": "false", "stop.time": "%g" % ((steps - 0.5) * float(dt))})
             listed.append((stepped_name(steps, nx, nz), full, 1))
@@ -115,7 +117,7 @@ def measure(builds, rounds):
         for name, settings, threads in cases():
             order = [b for b in builds if threads == 1 or b == "this build"]
             random.shuffle(order)
-            for _ in range(STARTUP_REPEATS if name.startswith("start-up") else 1):
+            for _ in range(STARTUP_REPEATS if name.startswith(STARTUP) else 1):
                 for build in order:
                     out = os.path.join(work, build.replace(" ", "_"))
                     wall, count, onsets = timed_run(builds[build], settings, threads, out)
@@ -180,7 +182,7 @@ def write(base, head, walls, steps, events, rounds, startup_repeats):
         label, nodes = "%d × %d" % (nx, nz), nx * nz
         for build in builds:
             whole = medians["first global event " + label][build]
-            startup = medians["start-up " + label][build]
+            startup = medians[STARTUP + label][build]
             cost = per_node_step(medians, build, nx, nz)
             run_steps = steps[("first global event " + label, build)]
             points[build].append((nodes, whole))
