@@ -160,6 +160,8 @@ void printEvent(const friction::Simulation& s, const friction::SlipEvent& event)
 }
 
 int run(int argc, char** argv) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
   Arguments args;
   if (const auto status = parseArguments(argc, argv, args)) return *status;
   double stability_limit = 0.0;
@@ -170,7 +172,6 @@ int run(int argc, char** argv) {
     protocol = friction::loadProtocol(args.protocol_path);
     scene.stop = {protocol.end.global_events, protocol.end.time, protocol.end.stage_travel};
   }
-  const auto start = std::chrono::steady_clock::now();
   friction::RunOptions options;
   // A recorded time is its step's rounded to whole nanoseconds: due within half of one. A protocol's
   // times are the ones the rig compared its clock with: due exactly then.
@@ -196,10 +197,12 @@ int run(int argc, char** argv) {
   });
   ProgressLine* progress = isatty(fileno(stderr)) ? &driver.add(std::make_unique<ProgressLine>()) : nullptr;
   results->addStreams(driver, printEvent);
+  const Clock::time_point first_step = Clock::now();
   driver.run();
   if (progress) progress->clear();
   driver.finishRun();
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  const double startup = std::chrono::duration<double>(first_step - start).count();
   const std::string& commands_source = args.commands_path.empty() ? args.protocol_path : args.commands_path;
   if (!commands_source.empty()) {
     std::cout << "commands: " << applied_commands << " of " << scheduled_commands << " applied (" << commands_source
@@ -210,7 +213,7 @@ int run(int argc, char** argv) {
               << simulation.time() << " s, brought to equilibrium by " << simulation.jumpCorrections()
               << " corrections\n";
   }
-  if (!results->finish(simulation, wall, std::cout)) {
+  if (!results->finish(simulation, wall, startup, std::cout)) {
     return refuseOutput(out_dir, "a result file could not be written in full");
   }
   std::cout << "results written to " << out_dir << "/\n";

@@ -21,13 +21,14 @@ struct RunSummary {
   double simulated_time = 0.0;  ///< s
   long long steps = 0;          ///< time steps integrated (a fast-forward jump counts as none)
   double wall_time = 0.0;       ///< s
+  double startup_time = 0.0;    ///< s of the wall time before the first step; 0 where not measured
   double relative_energy_residual =
       0.0;                       ///< work in − (Δelastic + kinetic + dissipated), over the budget's largest term
   double time_step = 0.0;        ///< s
   double stability_limit = 0.0;  ///< s
 };
 
-RunSummary summarize(const Simulation& simulation, double wall_time);
+RunSummary summarize(const Simulation& simulation, double wall_time, double startup_time = 0.0);
 void printSummary(std::ostream& out, const RunSummary& summary);
 
 /// One row per event. Its front speed is the running front's median v_c (summarizeFrontSpeeds), also as
@@ -61,9 +62,9 @@ class ResultsFolder {
   /// Registers the streams that write the tables on `driver`, the loading curve at the scene's
   /// instruments.loading_curve_rate from the state now; `ended` is called after each event's rows.
   void addStreams(RunDriver& driver, const EventStream::Ended& ended = nullptr);
-  /// Writes scene.yaml and summary.txt, the summary also to `console`. False if a file could not be
-  /// written in full.
-  bool finish(const Simulation& simulation, double wall_time, std::ostream& console);
+  /// Writes scene.yaml and summary.txt, the summary also to `console`; `startup_time` is the part of
+  /// `wall_time` before the first step. False if a file could not be written in full.
+  bool finish(const Simulation& simulation, double wall_time, double startup_time, std::ostream& console);
 
  private:
   std::string directory_;

@@ -12,7 +12,7 @@
 
 namespace friction {
 
-RunSummary summarize(const Simulation& simulation, double wall_time) {
+RunSummary summarize(const Simulation& simulation, double wall_time, double startup_time) {
   RunSummary summary;
   summary.scene_name = simulation.scene().name;
   summary.stop_reason = simulation.stopReason();
@@ -20,6 +20,7 @@ RunSummary summarize(const Simulation& simulation, double wall_time) {
   summary.simulated_time = simulation.time();
   summary.steps = simulation.steps();
   summary.wall_time = wall_time;
+  summary.startup_time = startup_time;
   summary.relative_energy_residual = simulation.energy().relativeResidual();
   summary.time_step = simulation.timeStep();
   summary.stability_limit = simulation.stabilityLimit();
@@ -30,8 +31,9 @@ void printSummary(std::ostream& out, const RunSummary& s) {
   out << "scene " << s.scene_name << ": " << s.stop_reason << "\n"
       << "  simulated " << s.simulated_time << " s in " << s.steps << " steps of " << s.time_step
       << " s (stability limit " << s.stability_limit << " s)\n"
-      << "  wall time " << std::setprecision(3) << s.wall_time << " s, " << std::setprecision(4)
-      << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
+      << "  wall time " << std::setprecision(3) << s.wall_time << " s";
+  if (s.startup_time > 0) out << " (before the first step " << s.startup_time << " s)";
+  out << ", " << std::setprecision(4) << (s.wall_time > 0 ? s.steps / s.wall_time : 0.0) << " steps/s\n"
       << "  slip events: " << s.events.events << ", precursors before the first global event: " << s.events.precursors;
   if (s.events.single_node_precursors > 0)
     out << " (single-node slips, L_p = 0, among them: " << s.events.single_node_precursors << ")";
@@ -177,12 +179,12 @@ void ResultsFolder::addStreams(RunDriver& driver, const EventStream::Ended& ende
   }));
 }
 
-bool ResultsFolder::finish(const Simulation& simulation, double wall_time, std::ostream& console) {
+bool ResultsFolder::finish(const Simulation& simulation, double wall_time, double startup_time, std::ostream& console) {
   std::ofstream scene_yaml, summary_txt;
   openAnew(scene_yaml, directory_ + "/scene.yaml");
   openAnew(summary_txt, directory_ + "/summary.txt");
   scene_yaml << sceneToYaml(simulation.scene());
-  const RunSummary summary = summarize(simulation, wall_time);
+  const RunSummary summary = summarize(simulation, wall_time, startup_time);
   printSummary(summary_txt, summary);
   printSummary(console, summary);
   for (std::ofstream* file : {&events_, &event_nodes_, &loading_, &stresses_, &scene_yaml, &summary_txt}) {
