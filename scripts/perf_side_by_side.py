@@ -43,6 +43,8 @@ WHOLE_RUN_SIZES = 3
 STARTUP_REPEATS = 7
 # The name of a start-up case (a run that stops at once) begins with this.
 STARTUP = "start-up "
+# A process that loads friction_run's libraries, prints its help and exits: the time before `main`.
+PROGRAM_LOAD = "program load (friction_run --help)"
 
 
 def short_commit(rev):
@@ -70,7 +72,7 @@ def stepped_name(steps, nx, nz, threads=1):
 
 def cases():
     """(name, settings, threads): start-up, stepping and whole runs at each size, and threads."""
-    listed = []
+    listed = [(PROGRAM_LOAD, None, 1)]
     for index, (nx, nz, dt) in enumerate(SIZES):
         size = {"lattice.nodes_x": nx, "lattice.nodes_z": nz, "integrator.time_step": dt}
         label = "%d × %d" % (nx, nz)
@@ -93,7 +95,13 @@ def per_node_step(medians, build, nx, nz, threads=1):
 
 
 def timed_run(runner, settings, threads, out):
-    """Wall time (s) of one run in a fresh process, its step count and its events' onsets and kinds."""
+    """Wall time (s) of one run in a fresh process, its step count, its events' onsets and kinds, and the
+    wall time from `main` to its first step (None where the build does not print it). With no settings,
+    the process only prints friction_run's help."""
+    if settings is None:
+        start = time.monotonic()
+        subprocess.run([runner, "--help"], check=True, stdout=subprocess.DEVNULL)
+        return time.monotonic() - start, 0, [], None
     args = [runner, SCENE, "--out", out]
     for key, value in settings.items():
         args += ["--set", "%s=%s" % (key, value)]
@@ -103,29 +111,34 @@ def timed_run(runner, settings, threads, out):
     subprocess.run(args, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     wall = time.monotonic() - start
     with open(os.path.join(out, "summary.txt")) as handle:
-        steps = int(re.search(r"in ([0-9]+) steps", handle.read()).group(1))
+        summary = handle.read()
+    steps = int(re.search(r"in ([0-9]+) steps", summary).group(1))
+    before_first_step = re.search(r"before the first step ([0-9.e+-]+) s", summary)
     with open(os.path.join(out, "events.csv")) as handle:
         events = [(row["onset_time_s"], row["global"]) for row in csv.DictReader(handle)]
-    return wall, steps, events
+    return wall, steps, events, float(before_first_step.group(1)) if before_first_step else None
 
 
 def measure(builds, rounds):
-    """{case name: {build: [wall per round]}}, steps and events per case and build."""
-    walls, steps, events = {}, {}, {}
+    """{case name: {build: [wall per round]}}, steps and events per case and build, and {case name: {build:
+    [s from `main` to the first step]}} for the builds that print it."""
+    walls, steps, events, first_steps = {}, {}, {}, {}
     work = tempfile.mkdtemp(prefix="side_by_side_")
     for round_index in range(rounds):
         for name, settings, threads in cases():
             order = [b for b in builds if threads == 1 or b == "this build"]
             random.shuffle(order)
-            for _ in range(STARTUP_REPEATS if name.startswith(STARTUP) else 1):
+            for _ in range(STARTUP_REPEATS if name.startswith(STARTUP) or name == PROGRAM_LOAD else 1):
                 for build in order:
                     out = os.path.join(work, build.replace(" ", "_"))
-                    wall, count, onsets = timed_run(builds[build], settings, threads, out)
+                    wall, count, onsets, before_first_step = timed_run(builds[build], settings, threads, out)
                     walls.setdefault(name, {}).setdefault(build, []).append(wall)
+                    if before_first_step is not None:
+                        first_steps.setdefault(name, {}).setdefault(build, []).append(before_first_step)
                     steps[(name, build)] = count
                     events[(name, build)] = onsets
                     print("round %d  %-40s %-12s %8.3f s" % (round_index + 1, name, build, wall), flush=True)
-    return walls, steps, events
+    return walls, steps, events, first_steps
 
 
 def spread(values):
@@ -152,7 +165,7 @@ def agreement(name, steps, events):
     return "same" if moved == 0.0 else "same, onsets within %.0e" % moved
 
 
-def write(base, head, walls, steps, events, rounds, startup_repeats):
+def write(base, head, walls, steps, events, first_steps, rounds, startup_repeats):
     builds = ["base", "this build"]
     lines = ["## This build against the one before, side by side", "",
              "The one before: %s." % base,
@@ -164,19 +177,23 @@ def write(base, head, walls, steps, events, rounds, startup_repeats):
              "| case | %s (s) | this build (s) | speed-up | steps and events |" % base, "|---|---|---|---|---|"]
     medians = {name: {b: statistics.median(v) for b, v in per_build.items()} for name, per_build in walls.items()}
     for name, _, threads in cases():
-        if threads > 1:
+        if threads > 1 or name not in walls:  # measurements kept from before a case was added lack it
             continue
         lines.append("| %s | %s | %s | %.2f× | %s |" % (name, spread(walls[name]["base"]),
                                                          spread(walls[name]["this build"]),
                                                          medians[name]["base"] / medians[name]["this build"],
+                                                         "" if name == PROGRAM_LOAD else
                                                          agreement(name, steps, events)))
     lines += ["", "### Where a whole run's time goes", "",
               "Per node-step: the difference of the %d- and %d-step full-dynamics runs over %d steps × nodes. "
               "Dynamic share: the whole run's steps × nodes at that cost, over its wall time. Start-up share: the "
               "start-up's wall time (a run that stops at once: building, checking and loading the slider, "
-              "fast-forward's set-up) over the whole run's." % (STEPPED, STEPPED + EXTRA, EXTRA), "",
-              "| lattice | build | whole run (s) | steps | ns per node-step | dynamic share | start-up share |",
-              "|---|---|---|---|---|---|---|"]
+              "fast-forward's set-up, and also writing its results and exiting) over the whole run's. Before the "
+              "first step: the program's load (a `friction_run --help` process) and the whole run's own time from "
+              "`main` to its first step (its summary's), over its wall time; a build that does not print it has "
+              "none." % (STEPPED, STEPPED + EXTRA, EXTRA), "",
+              "| lattice | build | whole run (s) | steps | ns per node-step | dynamic share | start-up share | "
+              "before the first step |", "|---|---|---|---|---|---|---|---|"]
     points = {b: [] for b in builds}
     for nx, nz, _ in SIZES[:WHOLE_RUN_SIZES]:
         label, nodes = "%d × %d" % (nx, nz), nx * nz
@@ -186,9 +203,11 @@ def write(base, head, walls, steps, events, rounds, startup_repeats):
             cost = per_node_step(medians, build, nx, nz)
             run_steps = steps[("first global event " + label, build)]
             points[build].append((nodes, whole))
-            lines.append("| %s | %s | %.2f | %d | %.1f | %.0f %% | %.0f %% |" % (
+            own = first_steps.get("first global event " + label, {}).get(build)
+            before = "%.1f %%" % (100 * (medians[PROGRAM_LOAD][build] + statistics.median(own)) / whole) if own else "–"
+            lines.append("| %s | %s | %.2f | %d | %.1f | %.0f %% | %.0f %% | %s |" % (
                 label, base if build == "base" else build, whole, run_steps, cost * 1e9,
-                100 * run_steps * nodes * cost / whole, 100 * startup / whole))
+                100 * run_steps * nodes * cost / whole, 100 * startup / whole, before))
     lines += ["", "Whole runs grow as N^%.2f with this build and N^%.2f with %s (least squares over %s nodes)." % (
         exponent(points["this build"]), exponent(points["base"]), base,
         ", ".join(str(nx * nz) for nx, nz, _ in SIZES[:WHOLE_RUN_SIZES]))]
@@ -215,18 +234,18 @@ def main():
             kept = json.load(handle)
         steps = {tuple(key.split("|")): value for key, value in kept["steps"].items()}
         events = {tuple(key.split("|")): [tuple(e) for e in value] for key, value in kept["events"].items()}
-        write(kept["base"], kept.get("head", "?"), kept["walls"], steps, events, kept["rounds"],
-              kept.get("startup_repeats", 1))
+        write(kept["base"], kept.get("head", "?"), kept["walls"], steps, events, kept.get("first_steps", {}),
+              kept["rounds"], kept.get("startup_repeats", 1))
         return
     head = short_commit("HEAD")
     commit, base_runner = build_baseline(args.base)
-    walls, steps, events = measure({"base": base_runner, "this build": RUNNER}, args.rounds)
+    walls, steps, events, first_steps = measure({"base": base_runner, "this build": RUNNER}, args.rounds)
     with open(MEASURED, "w") as handle:
         json.dump({"base": commit, "head": head, "rounds": args.rounds, "startup_repeats": STARTUP_REPEATS,
-                   "walls": walls,
+                   "walls": walls, "first_steps": first_steps,
                    "steps": {"|".join(key): value for key, value in steps.items()},
                    "events": {"|".join(key): value for key, value in events.items()}}, handle)
-    write(commit, head, walls, steps, events, args.rounds, STARTUP_REPEATS)
+    write(commit, head, walls, steps, events, first_steps, args.rounds, STARTUP_REPEATS)
     print("written", REPORT)
 
 
