@@ -204,7 +204,8 @@ def write(base, head, walls, steps, events, first_steps, rounds, startup_repeats
             run_steps = steps[("first global event " + label, build)]
             points[build].append((nodes, whole))
             own = first_steps.get("first global event " + label, {}).get(build)
-            before = "%.1f %%" % (100 * (medians[PROGRAM_LOAD][build] + statistics.median(own)) / whole) if own else "–"
+            before = ("%.1f %%" % (100 * (medians[PROGRAM_LOAD][build] + statistics.median(own)) / whole)
+                      if own else "–")
             lines.append("| %s | %s | %.2f | %d | %.1f | %.0f %% | %.0f %% | %s |" % (
                 label, base if build == "base" else build, whole, run_steps, cost * 1e9,
                 100 * run_steps * nodes * cost / whole, 100 * startup / whole, before))

@@ -11,6 +11,7 @@ import argparse
 import csv
 import math
 import os
+import re
 import sys
 
 import matplotlib
@@ -23,6 +24,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sweep  # noqa: E402
 import validation_rate_state  # noqa: E402
+from perf_report import cpu_model  # noqa: E402
 from sweep import first_global, precursors  # noqa: E402
 
 ROOT = sweep.ROOT
@@ -213,17 +215,42 @@ def main():
     parser.add_argument("--jobs", default=None)
     parser.add_argument("--hosts", default=None)
     args = parser.parse_args()
-    data = {}
+    data, failures = {}, {}
     names = ["normal_load", "stage_speed", "pushing_height", "friction_law", "one_d", "resolution"]
     for name in names + validation_rate_state.SWEEPS:
-        rows, failed = sweep.run(os.path.join(ROOT, "sweeps", name + ".yaml"), args.jobs, args.hosts)
+        rows, failures[name] = sweep.run(os.path.join(ROOT, "sweeps", name + ".yaml"), args.jobs, args.hosts)
         data[name] = runs_of(rows)
-        if failed:
-            print("validation: %s: failed runs %s" % (name, failed), file=sys.stderr)
-    write(data)
+        if failures[name]:
+            print("validation: %s: failed runs %s" % (name, failures[name]), file=sys.stderr)
+    write(data, failures)
 
 
-def write(data):
+def sweep_cost(name):
+    """A sweep's finished runs and their wall times (s), each as its own summary gives it."""
+    walls = []
+    for point in sweep.combinations(sweep.load(os.path.join(ROOT, "sweeps", name + ".yaml"))):
+        summary = os.path.join(ROOT, "sweeps", name, "runs", sweep.run_id(point), "summary.txt")
+        if os.path.exists(summary):
+            with open(summary) as handle:
+                walls.append(float(re.search(r"wall time ([0-9.e+-]+) s", handle.read()).group(1)))
+    return walls
+
+
+def cost_section(failures):
+    """What each sweep costs: its runs, their wall times summed and the longest, and the runs that failed."""
+    L = ["## The sweeps and their cost", "",
+         "Each run's wall time as its summary gives it, in its own process, measured when it ran (a rerun reuses "
+         "finished runs). Summed, it is the sweep's cost on one core; GNU parallel spreads the runs over cores "
+         "and hosts. This report's runs ran on %s, %d cores." % (cpu_model(), os.cpu_count()), "",
+         "| sweep | runs | failed | wall time, summed (s) | the longest run (s) |", "|---|---|---|---|---|"]
+    for name, failed in failures.items():
+        walls = sweep_cost(name)
+        L.append("| `sweeps/%s.yaml` | %d | %s | %.1f | %.1f |" % (
+            name, len(walls), ", ".join(failed) if failed else "none", sum(walls), max(walls, default=0.0)))
+    return L + [""]
+
+
+def write(data, failures):
     L = []
     default = data["normal_load"]["normal_force=1920"]
     pre = precursors(default)
@@ -594,6 +621,7 @@ def write(data):
               ", ".join(str(len(precursors(v))) for v in runs)) +
           "Convergence in dt at 57 × 31 is in docs/PERFORMANCE.md (every mode against a 50 ns reference).", ""]
     L += validation_rate_state.sections(data)
+    L += cost_section(failures)
     open(os.path.join(ROOT, "docs/VALIDATION.md"), "w").write("\n".join(L) + "\n")
     print("wrote docs/VALIDATION.md")
 
