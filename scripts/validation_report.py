@@ -241,12 +241,13 @@ def cost_section(failures):
     L = ["## The sweeps and their cost", "",
          "Each run's wall time as its summary gives it, in its own process, measured when it ran (a rerun reuses "
          "finished runs). Summed, it is the sweep's cost on one core; GNU parallel spreads the runs over cores "
-         "and hosts. This report's runs ran on %s, %d cores." % (cpu_model(), os.cpu_count()), "",
+         "and hosts. This report was written on %s, %d cores." % (cpu_model(), os.cpu_count()), "",
          "| sweep | runs | failed | wall time, summed (s) | the longest run (s) |", "|---|---|---|---|---|"]
     for name, failed in failures.items():
         walls = sweep_cost(name)
-        L.append("| `sweeps/%s.yaml` | %d | %s | %.1f | %.1f |" % (
-            name, len(walls), ", ".join(failed) if failed else "none", sum(walls), max(walls, default=0.0)))
+        L.append("| `sweeps/%s.yaml` | %d | %s | %s | %s |" % (
+            name, len(walls), ", ".join(failed) if failed else "none", "%.1f" % sum(walls) if walls else "–",
+            "%.1f" % max(walls) if walls else "–"))
     return L + [""]
 
 
