@@ -153,6 +153,21 @@ def ages_at_peaks(run_dir, windows, trailing_length):
     return [tuple(float(numpy.median(c)) if c else math.nan for c in coefficients[i]) for i in range(len(windows))]
 
 
+def reach_envelope(events):
+    """[(onset F_X/F_Z, the largest L_p/L reached by then)] over a run's precursors, in their order: the
+    interface's invaded extent as the load rises, whatever the lattice splits it into."""
+    envelope, reach = [], 0.0
+    for event in precursors(events):
+        reach = max(reach, vr.f(event, "length_ratio"))
+        envelope.append((vr.f(event, "shear_ratio"), reach))
+    return envelope
+
+
+def reach_at(envelope, load):
+    """The largest L_p/L reached by precursors with onsets at or below `load` (F_X/F_Z)."""
+    return max([reach for onset, reach in envelope if onset <= load] + [0.0])
+
+
 def log_slope(points):
     """The least-squares slope of y against ln x over the finite points (x, y); nan with fewer than two."""
     finite = [(x, y) for x, y in points if math.isfinite(y)]
@@ -381,67 +396,66 @@ def sections(data):
     coulomb_counts = [len(precursors(v)) for _, v in coulomb]
     L += ["### 10.6 Convergence with the lattice", "",
           "Amontons–Coulomb gives %s precursors at %s (§9): it has no length to converge to. The rate-and-state "
-          "law has L_b (%.1f mm). Slips shorter than L_b are bursts of the creeping trailing edge that a finer "
-          "lattice resolves into more, smaller ones; the precursors longer than L_b are the fronts that "
-          "nucleated, and they are what is compared." % (
+          "law has L_b (%.1f mm). Its trailing patch creeps and slips again and again over a slowly growing "
+          "extent, and a finer lattice splits that creep into more, smaller events: counts of precursors cannot "
+          "converge. What is compared is the invaded extent: the largest L_p/L reached by the precursors as "
+          "F_X/F_Z rises (the curves of the figure), and µ_s,macro." % (
               ", ".join(map(str, coulomb_counts)),
               ", ".join("%s × %s" % (k.split("nodes_x=")[1].split("_")[0], k.split("nodes_z=")[1].split("_")[0])
                         for k, _ in coulomb), length * 1e3),
-          "", "| lattice | L_b / spacing | precursors | with L_p > 0 | longer than L_b | µ_s,macro | onset F_X/F_Z of "
-          "those longer than L_b |", "|---|---|---|---|---|---|---|"]
-    labels, spans, nucleated, macros = [], [], [], []
+          "", "| lattice | L_b / spacing | precursors | with L_p > 0 | longer than L_b | µ_s,macro | largest L_p/L "
+          "reached at F_X/F_Z = 0.30, 0.33, 0.36 |", "|---|---|---|---|---|---|---|"]
+    labels, spans, envelopes, macros = [], [], [], []
     for k, v in by_size:
         nx = int(k.split("nodes_x=")[1].split("_")[0])
         labels.append("%d × %s" % (nx, k.split("nodes_z=")[1].split("_")[0]))
         spans.append(length / (float(_SCENE["geometry"]["length"]) / (nx - 1)))
-        nucleated.append([e for e in precursors(v) if vr.f(e, "rupture_length_m") > length])
+        envelopes.append(reach_envelope(v))
         g = first_global(v)
         macros.append(vr.f(g, "peak_shear_ratio") if g else math.nan)
         L.append("| %s | %.1f | %d | %d | %d | %s | %s |" % (
-            labels[-1], spans[-1], len(precursors(v)), len(extended_precursors(v)), len(nucleated[-1]),
-            vr.macro_cell(v), ", ".join("%.3f" % vr.f(e, "shear_ratio") for e in nucleated[-1])))
+            labels[-1], spans[-1], len(precursors(v)), len(extended_precursors(v)),
+            sum(1 for e in precursors(v) if vr.f(e, "rupture_length_m") > length), vr.macro_cell(v),
+            ", ".join("%.2f" % reach_at(envelopes[-1], ratio) for ratio in (0.30, 0.33, 0.36))))
     if len(by_size) < 2:
         return L + ["", "Fewer than two lattices finished: nothing to compare.", ""]
     fig_res = vr.figure("validation_rate_state_resolution.png", [
-        ("rate_state, lattice", [(label, run + [g for g in [first_global(v)] if g])
-                                 for label, run, (_, v) in zip(labels, nucleated, by_size)])])
-    steps = [numpy.median(numpy.diff([vr.f(e, "shear_ratio") for e in run])) if len(run) > 1 else math.nan
-             for run in nucleated]
+        ("rate_state, lattice", [(label, extended(v)) for label, (_, v) in zip(labels, by_size)])])
     L += ["", "![rate_state at each resolution](%s)" % fig_res, "",
-          "The figure draws the precursors longer than L_b and the first global event (star). For each refinement, "
-          "coarse → fine: the relative difference of µ_s,macro; the median step of F_X/F_Z between successive "
-          "precursors on each lattice; the curve's difference, the median |ΔL_p/L| of the finer lattice's "
-          "precursors from the coarser's curve (L_p/L against F_X/F_Z, joined by straight lines) over the range "
-          "both cover; the precursors' counts.", "",
-          "| refinement | Δµ_s,macro | median steps | ΔL_p/L (median) | precursors longer than L_b |",
-          "|---|---|---|---|---|"]
-    macro_changes, curve = [], []
+          "For each refinement, coarse → fine: the relative difference of µ_s,macro, and the median difference "
+          "of the largest L_p/L reached, over 50 loads from where both lattices' precursors first reach L_b to the "
+          "lower µ_s,macro.", "", "| refinement | Δµ_s,macro | Δ(largest L_p/L), median |", "|---|---|---|"]
+    macro_changes, reach_changes = [], []
     for i in range(1, len(by_size)):
-        coarse = sorted((vr.f(e, "shear_ratio"), vr.f(e, "length_ratio")) for e in nucleated[i - 1])
-        inside = [(x, y) for x, y in ((vr.f(e, "shear_ratio"), vr.f(e, "length_ratio")) for e in nucleated[i])
-                  if coarse and coarse[0][0] <= x <= coarse[-1][0]]
-        curve.append(numpy.median([abs(y - numpy.interp(x, *zip(*coarse))) for x, y in inside]) if inside
-                     else math.nan)
+        starts = [next((onset for onset, reach in envelope if reach * float(_SCENE["geometry"]["length"]) > length),
+                       math.nan) for envelope in envelopes[i - 1:i + 1]]
+        low, high = max(starts), min(macros[i - 1], macros[i])
+        grid = numpy.linspace(low, high, 50) if low < high else []
+        reach_changes.append(numpy.median([abs(reach_at(envelopes[i], x) - reach_at(envelopes[i - 1], x))
+                                           for x in grid]) if len(grid) else math.nan)
         macro_changes.append(abs(macros[i] / macros[i - 1] - 1))
-        L.append("| %s → %s | %.1f %% | %.4f → %.4f | %.3f | %d → %d |" % (
-            labels[i - 1], labels[i], 100 * macro_changes[-1], steps[i - 1], steps[i], curve[-1],
-            len(nucleated[i - 1]), len(nucleated[i])))
+        L.append("| %s → %s | %.1f %% | %.3f |" % (labels[i - 1], labels[i], 100 * macro_changes[-1],
+                                                    reach_changes[-1]))
     finest = "%s → %s" % (labels[-2], labels[-1])
-    if len(curve) < 2 or not all(math.isfinite(x) for x in macro_changes[-2:] + curve[-2:]):
-        trend = "One refinement only: whether the differences narrow needs another."
-    elif macro_changes[-1] <= macro_changes[-2] and curve[-1] <= curve[-2]:
-        trend = ("µ_s,macro's difference and the curve's narrow from one refinement to the next (%.1f %% → %.1f %%, "
-                 "%.3f → %.3f L): with L_b over %.0f spacings or more the sequence's macroscopic values hold to "
-                 "those tolerances." % (100 * macro_changes[-2], 100 * macro_changes[-1], curve[-2], curve[-1],
-                                        spans[-2]))
+    trends = []
+    if len(macro_changes) > 1 and all(math.isfinite(x) for x in macro_changes[-2:] + reach_changes[-2:]):
+        for name, changes, unit in (("µ_s,macro", [100 * c for c in macro_changes], " %%"),
+                                    ("the invaded extent", reach_changes, " L")):
+            trends.append("%s's difference %s (%.3g%s → %.3g%s)" % (
+                name, "narrows" if changes[-1] <= changes[-2] else "grows", changes[-2], unit, changes[-1], unit))
+        trend = "From one refinement to the next, %s." % " and ".join(trends)
+        if reach_changes[-1] <= reach_changes[-2]:
+            trend += (" The invaded extent holds to %.3f L once L_b spans %.0f spacings (%s)." % (
+                reach_changes[-1], spans[-2], labels[-2]))
+        if macro_changes[-1] > macro_changes[-2]:
+            trend += (" µ_s,macro is not converged at these resolutions: no lattice here gives it to better than "
+                      "%.0f %%." % (100 * macro_changes[-1]))
     else:
-        trend = ("The differences do not narrow from one refinement to the next (µ_s,macro %.1f %% → %.1f %%, the "
-                 "curve %.3f → %.3f L): convergence is not shown at these resolutions." % (
-                     100 * macro_changes[-2], 100 * macro_changes[-1], curve[-2], curve[-1]))
+        trend = "One refinement only: whether the differences narrow needs another."
     coulomb_rising = all(b > a for a, b in zip(coulomb_counts, coulomb_counts[1:]))
-    L += ["", "*Agreement*: %s: µ_s,macro within %.1f %%, the precursors' curve within %.3f L, their count %d → %d. "
-          "%s Amontons–Coulomb's count %s (%s)." % (
-              finest, 100 * macro_changes[-1], curve[-1], len(nucleated[-2]), len(nucleated[-1]), trend,
+    L += ["", "*Agreement*: %s: µ_s,macro within %.1f %%, the invaded extent within %.3f L (median). %s "
+          "Amontons–Coulomb's count %s (%s)." % (
+              finest, 100 * macro_changes[-1], reach_changes[-1], trend.replace("%%", "%"),
               "rises at every refinement" if coulomb_rising else "changes with the lattice",
               " → ".join(map(str, coulomb_counts))), ""]
 
