@@ -240,8 +240,8 @@ def cost_section(failures):
     """What each sweep costs: its runs, their wall times summed and the longest, and the runs that failed."""
     L = ["## The sweeps and their cost", "",
          "Each run's wall time as its summary gives it, in its own process, measured when it ran (a rerun reuses "
-         "finished runs). Summed, it is the sweep's wall time with its runs one at a time; GNU parallel spreads the runs over cores "
-         "and hosts. This report was written on %s, %d cores." % (cpu_model(), os.cpu_count()), "",
+         "finished runs). Summed, it is the sweep's wall time with its runs one at a time; GNU parallel spreads "
+         "the runs over cores and hosts. This report was written on %s, %d cores." % (cpu_model(), os.cpu_count()), "",
          "| sweep | runs | failed | wall time, summed (s) | the longest run (s) |", "|---|---|---|---|---|"]
     for name, failed in failures.items():
         walls = sweep_cost(name)
