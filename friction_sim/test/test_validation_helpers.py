@@ -40,7 +40,6 @@ class ValidationHelpersTest(unittest.TestCase):
         self.assertEqual(vrs.reach_at(envelope, 0.28), 0.40)
         self.assertEqual(vrs.reach_at(envelope, 0.50), 0.55)  # the global event is not a precursor
 
-
     def test_slides_after_holds_start_and_end_where_the_protocol_says(self):
         protocol = os.path.join(self.work, "protocol.yaml")
         with open(protocol, "w") as handle:
