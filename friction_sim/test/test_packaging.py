@@ -1,11 +1,15 @@
 #!/usr/bin/python3
 """The three catkin packages as catkin_lint reads them: no problem at -W1 (errors and warnings), so that
-they build and install the way catkin users expect (dependencies exported, everything installed)."""
+they build and install the way catkin users expect (dependencies exported, everything installed); and
+the built programs look for their libraries only where their RUNPATH names."""
 import os
+import re
 import subprocess
 import unittest
 
 import rosunit
+
+import built
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
@@ -15,6 +19,15 @@ class PackagingTest(unittest.TestCase):
         done = subprocess.run(["catkin_lint", "-W1", "--pkg", "friction_msgs", "--pkg", "friction_sim", "--pkg",
                                "friction_rviz", "--package-path", ROOT], capture_output=True, text=True, timeout=300)
         self.assertIn("checked 3 packages and found 0 problems", done.stderr + done.stdout, done.stdout + done.stderr)
+
+    def test_no_library_is_looked_for_in_the_working_directory(self):
+        # An empty RUNPATH entry means the working directory to the loader.
+        dynamic = subprocess.run(["readelf", "-d", built.friction_run()], capture_output=True, text=True,
+                                 check=True).stdout
+        paths = re.findall(r"\((?:RUNPATH|RPATH)\)\s+Library r(?:un)?path: \[(.*)\]", dynamic)
+        self.assertTrue(paths, dynamic)
+        for path in paths:
+            self.assertNotIn("", path.split(":"), path)
 
 
 if __name__ == "__main__":
