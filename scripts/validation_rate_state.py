@@ -17,8 +17,14 @@ SWEEPS = ["rate_state_normal_load", "rate_state_resolution", "slip_weakening_nor
 with open(os.path.join(sweep.ROOT, "friction_sim/scenes/pmma_2d_rate_state.yaml")) as _scene:
     _SCENE = yaml.safe_load(_scene)
 _LAW = {key: float(value) for key, value in _SCENE["friction"].items() if key != "law"}
-DEFAULT_RUN = "normal_force=1920"
 DEFAULT_LOAD = float(_SCENE["load"]["normal_force"])  # N
+DEFAULT_RUN = "normal_force=%g" % DEFAULT_LOAD  # its run in sweeps/rate_state_normal_load.yaml
+SLIDER_LENGTH = float(_SCENE["geometry"]["length"])  # m
+
+
+def spacing(nodes_x):
+    """m, the lattice spacing along the slider with `nodes_x` nodes in a row."""
+    return SLIDER_LENGTH / (nodes_x - 1)
 
 
 def nucleation_length(normal_force):
@@ -65,8 +71,8 @@ def fast_to_slow(points, fit_nodes, run_length=3):
     points = sorted(points)
     if len(points) < 2:
         return None
-    spacing = min(b[0] - a[0] for a, b in zip(points, points[1:]))
-    points = [p for p in points if p[0] >= points[0][0] + fit_nodes * spacing]
+    gap = min(b[0] - a[0] for a, b in zip(points, points[1:]))
+    points = [p for p in points if p[0] >= points[0][0] + fit_nodes * gap]
     speeds = [p[1] for p in points]
     slow = slow_speed()
     for i in range(run_length, len(speeds) - run_length + 1):
@@ -207,8 +213,9 @@ def sections(data):
          "`pmma_2d_rate_state`: the default slider with `friction.law: rate_state` (MODEL.md §4, PMMA values of "
          "Bar-Sinai et al. 2014), contacts 100 s old when the stage starts, events counted from a slip speed of "
          "1 mm/s (docs/analysis.md, slip events). 57 × 31, to the first global event. Nucleation length "
-         "L_b = G·D/(b·f0·σ̄) = %.1f mm at F_Z = 1920 N: %.1f lattice spacings." % (
-             nucleation_length(1920) * 1e3, nucleation_length(1920) / (0.140 / 56)), "",
+         "L_b = G·D/(b·f0·σ̄) = %.1f mm at F_Z = %g N: %.1f lattice spacings." % (
+             nucleation_length(DEFAULT_LOAD) * 1e3, DEFAULT_LOAD,
+             nucleation_length(DEFAULT_LOAD) / spacing(int(_SCENE["lattice"]["nodes_x"]))), "",
          "*Rig*: %d precursors before the first global event at F_X/F_Z = %.4f (µ_s,macro; Amontons–Coulomb "
          "with µ_s = 0.4: 6 precursors, 0.2078)." % (len(pre), vr.f(g, "peak_shear_ratio")) if g else "no global event", ""]
 
@@ -251,11 +258,11 @@ def sections(data):
     # it turned) and where it ran slow; and whether the slip behind still ran while the front ran slow.
     prestress = onset_prestress("rate_state_normal_load", DEFAULT_RUN)
     times = event_nodes("rate_state_normal_load", DEFAULT_RUN, ("first_unstick_time_s", "last_slip_time_s"))
-    spacing = float(_SCENE["geometry"]["length"]) / (int(_SCENE["lattice"]["nodes_x"]) - 1)
+    node_spacing = spacing(int(_SCENE["lattice"]["nodes_x"]))
     rows = []
     for i, (turn, run_slow) in transitions:
         profile = prestress.get(i, [])
-        fast, slow = (turn - 3 * spacing, turn), (turn, turn + run_slow + 0.5 * spacing)
+        fast, slow = (turn - 3 * node_spacing, turn), (turn, turn + run_slow + 0.5 * node_spacing)
         rows.append((i, turn, run_slow, mean_ratio(profile, *fast), mean_ratio(profile, *slow),
                      mean_ratio(profile, *fast, column=2), mean_ratio(profile, *slow, column=2),
                      still_slipping_behind(times.get(i, []), turn, turn + run_slow)))
@@ -430,7 +437,7 @@ def sections(data):
     for k, v in by_size:
         nx = int(k.split("nodes_x=")[1].split("_")[0])
         labels.append("%d × %s" % (nx, k.split("nodes_z=")[1].split("_")[0]))
-        spans.append(length / (float(_SCENE["geometry"]["length"]) / (nx - 1)))
+        spans.append(length / spacing(nx))
         envelopes.append(reach_envelope(v))
         g = first_global(v)
         macros.append(vr.f(g, "peak_shear_ratio") if g else math.nan)
@@ -448,7 +455,7 @@ def sections(data):
           "lower µ_s,macro.", "", "| refinement | Δµ_s,macro | Δ(largest L_p/L), median |", "|---|---|---|"]
     macro_changes, reach_changes = [], []
     for i in range(1, len(by_size)):
-        starts = [next((onset for onset, reach in envelope if reach * float(_SCENE["geometry"]["length"]) > length),
+        starts = [next((onset for onset, reach in envelope if reach * SLIDER_LENGTH > length),
                        math.nan) for envelope in envelopes[i - 1:i + 1]]
         low, high = max(starts), min(macros[i - 1], macros[i])
         grid = numpy.linspace(low, high, 50) if low < high else []
