@@ -74,6 +74,25 @@ TEST_F(OneAgeingNode, SlidingFrictionIsSolvedWithTheVelocityAtTheKicksEnd) {
   EXPECT_GT(end_speed, v_[0]);  // pushed beyond µ·N: it speeds up
 }
 
+TEST(RateAndStateLaw, KicksEndSpeedIsTheSameRootFromAnyFirstGuess) {
+  RateAndState law(kPmma);
+  law.resize(1);
+  const double mu_rest = kPmma.staticCoefficient(kPmma.initial_age);
+  // A slide at 1 mm/s and a creep at 1 µm/s, each from below, near, at and above its root, from rest,
+  // moving backwards and from no guess at all (NaN).
+  for (const double target : {1e-3, 1e-6}) {
+    const double resistance = 0.02;  // m/s per unit of µ
+    const double reach = target + resistance * kPmma.coefficient(target, kPmma.initial_age);
+    ASSERT_GT(reach - resistance * mu_rest, 0.0);
+    for (const double guess : {0.0, 1e-9, 0.5 * target, target, 1.001 * target, 2.0 * target, 1.0, -target,
+                               std::numeric_limits<double>::quiet_NaN()}) {
+      const double speed = law.endSpeed(0, reach, resistance, guess);
+      EXPECT_NEAR(speed, target, 1e-13 * target) << "guess " << guess;
+      EXPECT_NEAR(speed + resistance * law.coefficientAt(0, speed), reach, 1e-15 * reach) << "guess " << guess;
+    }
+  }
+}
+
 TEST_F(OneAgeingNode, NodeThatFrictionAtRestWouldStopEndsItsKickMovingBackToReStick) {
   ASSERT_TRUE(update(9.0, 10.0));
   v_[0] = 1e-6;

@@ -42,8 +42,9 @@ class FrictionLaw {
   /// The speed y (m/s) at which `node` ends a step's closing kick, from y + resistance·µ(y) = reach: `reach`
   /// (m/s) is the speed it would reach without friction, `resistance` (m/s) the kick's speed per unit of
   /// µ (half the step times N over the node's mass). Negative if friction at rest, µ(0), stops it within
-  /// the kick: reach − resistance·µ(0).
-  virtual double endSpeed(int node, double reach, double resistance) const {
+  /// the kick: reach − resistance·µ(0). `start_speed` (m/s, along the slip), the node's speed before the
+  /// kick, is a first guess: it changes the answer within round-off only.
+  virtual double endSpeed(int node, double reach, double resistance, double /*start_speed*/) const {
     return reach - resistance * coefficientAt(node, 0.0);
   }
   /// µ_s of `node` if it stays stuck for `elapsed` (s) more.
@@ -107,7 +108,7 @@ class RateAndState : public FrictionLaw {
   bool rateDependent() const override { return true; }
   void setTime(double time) override { now_ = time; }
   double coefficientAt(int node, double speed) const override { return spec_.coefficient(speed, age(node)); }
-  double endSpeed(int node, double reach, double resistance) const override;
+  double endSpeed(int node, double reach, double resistance, double start_speed) const override;
   double staticCoefficientAfter(int node, double elapsed) const override {
     return spec_.staticCoefficient(age(node) + elapsed);
   }

@@ -185,7 +185,8 @@ void ContactInterface::solveSlidingFriction(const double* v, double closing_kick
     const double direction = friction_mode_[node];
     const double normal = latest_normal_[node];
     const double reach = direction * (v[dof] + kick_per_force * other_force_[node]);
-    const double speed = closing_kick > 0.0 ? law_->endSpeed(node, reach, kick_per_force * normal) : reach;
+    const double speed =
+        closing_kick > 0.0 ? law_->endSpeed(node, reach, kick_per_force * normal, direction * v[dof]) : reach;
     const double mu = law_->coefficientAt(node, std::max(speed, 0.0));
     sliding_coefficient_[node] = mu;
     friction_[current_slot_][node] = -mu * normal * direction;

@@ -34,22 +34,29 @@ void RateAndState::onSlip(int node, double slip) {
   since_[node] = now_;
 }
 
-double RateAndState::endSpeed(int node, double reach, double resistance) const {
+double RateAndState::endSpeed(int node, double reach, double resistance, double start_speed) const {
   const double at_rest = coefficientAt(node, 0.0);
   const double fastest = reach - resistance * at_rest;
   if (fastest <= 0.0) return fastest;
   // In x = ln(1 + y/v*), y + resistance·µ(y) = reach reads v*(e^x − 1) + resistance·(µ(0) + a·x) = reach:
-  // convex and increasing in x, so Newton's method from above (the speed with µ(0)) converges monotonically.
+  // convex and increasing in x. Newton's method converges monotonically from above, and from below its
+  // first step lands above. In a slide the speed before the kick is close: two or three iterations do.
+  // The speed with µ(0) bounds the root from above.
   const double v_star = spec_.reference_speed, a = spec_.direct_effect;
-  double x = std::log1p(fastest / v_star);
+  const double highest = std::log1p(fastest / v_star);
+  double x = start_speed > 0.0 && start_speed < fastest ? std::log1p(start_speed / v_star) : highest;
+  double speed = 0.0;
   constexpr int kMaxIterations = 200;
   for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
-    const double excess = v_star * std::expm1(x) + resistance * (at_rest + a * x) - reach;
-    const double step = excess / (v_star * std::exp(x) + resistance * a);
-    if (!(step > 1e-15 * x)) break;
-    x -= step;
+    speed = v_star * std::expm1(x);
+    const double excess = speed + resistance * (at_rest + a * x) - reach;
+    // The slope needs a few digits only: v*·e^x from the speed at hand rather than another exponential.
+    const double step = excess / (speed + v_star + resistance * a);
+    // Below the root only at the guess: past the first step, a negative one is round-off.
+    if (!(step > 1e-15 * x) && !(iteration == 0 && step < 0.0)) break;
+    x = std::min(x - step, highest);
   }
-  return v_star * std::expm1(x);
+  return speed;
 }
 
 void RateAndState::onLanding(int node) {
