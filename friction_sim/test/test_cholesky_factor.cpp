@@ -85,11 +85,29 @@ TEST(CholeskyFactor, SinglePrecisionSolveMatchesTheDoubleSolve) {
   }
 }
 
+TEST(CholeskyFactor, SolvingColumnsTogetherGivesEachColumnsOwnSolveToTheBit) {
+  // 37 columns: sweeps of 16, 16 and 5 (8 wide); 3 columns: one sweep 4 wide.
+  for (const SparseMatrix& lower :
+       {gridLaplacian(70, 1e-3), denseMatrix(45), tridiagonal(500), randomSparse(900, 3, 4)}) {
+    const CholeskyFactor factor(lower);
+    std::srand(5);
+    for (const int columns : {37, 3}) {
+      const Eigen::MatrixXd rhs = Eigen::MatrixXd::Random(lower.rows(), columns);
+      const Eigen::MatrixXd together = factor.solveColumns(rhs);
+      for (int c = 0; c < columns; ++c) {
+        const Vector alone = factor.solve(rhs.col(c));
+        EXPECT_EQ((together.col(c) - alone).cwiseAbs().maxCoeff(), 0.0) << lower.rows() << " column " << c;
+      }
+    }
+  }
+}
+
 TEST(CholeskyFactor, SolvesWithoutUnknowns) {
   // Nothing to solve for: an empty factor, not an error (AMD itself refuses empty arrays).
   const CholeskyFactor factor(SparseMatrix(0, 0));
   EXPECT_EQ(factor.solve(Vector()).size(), 0);
   EXPECT_EQ(factor.solveSinglePrecision(Vector()).size(), 0);
+  EXPECT_EQ(factor.solveColumns(Eigen::MatrixXd(0, 3)).size(), 0);
 }
 
 TEST(CholeskyFactor, RefusesASingularMatrix) {

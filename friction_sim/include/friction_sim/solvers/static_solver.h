@@ -71,6 +71,9 @@ class StaticSolver {
 
   /// Displacement of the free degrees of freedom per unit of a force vector on them (K_ff⁻¹·f).
   Vector response(const Vector& force) const;
+  /// response() of each column of `forces`, to the same bits. The direct method solves the columns
+  /// together, several per sweep of its factor.
+  Eigen::MatrixXd responses(const Eigen::MatrixXd& forces) const;
 
   const std::vector<int>& freeDofs() const { return free_dofs_; }
   /// m, what solve() may leave of a free degree of freedom's displacement.
@@ -86,6 +89,9 @@ class StaticSolver {
   Vector reducedResponse(const Vector& reduced, bool single_precision = false) const;
   /// response(), through the single-precision factor if `single_precision`.
   Vector response(const Vector& force, bool single_precision) const;
+  /// Turns the factored stiffness's response on the free degrees of freedom into that of the stiffness
+  /// with the springs of withAddedSprings (none: unchanged).
+  void addSpringsTo(Vector& solution) const;
   /// The responses (free dofs) to a unit force at each free position in `positions`, one column each.
   Eigen::MatrixXd unitResponses(const std::vector<int>& positions, bool single_precision) const;
   /// Turns `solution`, the factored stiffness's response on the free degrees of freedom, into that of the

@@ -5,6 +5,7 @@
 
 #include "friction_sim/run/simulation.h"
 #include "friction_sim/solvers/static_solver.h"
+#include "solvers/cholesky_factor.h"
 
 namespace friction {
 
@@ -26,23 +27,33 @@ void QuasiStaticCreep::linearise(const StaticSolver& solver, const ForceEvaluati
   const Vector& u = s.displacements();
   const double stage = s.stage().position();
   const int columns = static_cast<int>(nodes_.size()) + 1;
+  const Vector at_rest = Vector::Zero(u.size());
+  const double probe = 1e-6 * model.nodeSpacing();
+  // A creeping node moved with every other node in contact pinned and the bulk in equilibrium, or the
+  // stage moved with the whole interface pinned: each column's force with its unit motion alone, then
+  // the bulk's responses to a sweep's worth of columns at once (more would only hold more memory).
+  auto unitMotion = [&](int column) {
+    Vector along = Vector::Zero(u.size());
+    if (column < columns - 1) along[contact.dofs()[nodes_[column]]] = 1.0;
+    return along;
+  };
+  auto stageAt = [&](int column) { return stage + (column == columns - 1 ? probe : 0.0); };
+  ForceEvaluation moved;
   displacement_.resize(u.size(), columns);
+  for (int first = 0; first < columns; first += CholeskyFactor::kColumnsPerSweep) {
+    const int count = std::min(CholeskyFactor::kColumnsPerSweep, columns - first);
+    Eigen::MatrixXd imbalance(u.size(), count);
+    for (int i = 0; i < count; ++i) {
+      model.evaluate(u + probe * unitMotion(first + i), at_rest, stageAt(first + i), moved);
+      imbalance.col(i) = (moved.force - here.force) / probe;
+    }
+    displacement_.middleCols(first, count) = solver.responses(imbalance);
+  }
   force_.resize(contact.size(), columns);
   normal_.resize(contact.size(), columns);
-  const Vector at_rest = Vector::Zero(u.size());
-  ForceEvaluation moved;
-  const double probe = 1e-6 * model.nodeSpacing();
   for (int column = 0; column < columns; ++column) {
-    // A creeping node moved with every other node in contact pinned and the bulk in equilibrium, or the
-    // stage moved with the whole interface pinned.
-    const bool stage_column = column == columns - 1;
-    Vector along = Vector::Zero(u.size());
-    if (!stage_column) along[contact.dofs()[nodes_[column]]] = 1.0;
-    const double stage_shift = stage_column ? probe : 0.0;
-    model.evaluate(u + probe * along, at_rest, stage + stage_shift, moved);
-    along += solver.response((moved.force - here.force) / probe);
-    model.evaluate(u + probe * along, at_rest, stage + stage_shift, moved);
-    displacement_.col(column) = along;
+    displacement_.col(column) += unitMotion(column);
+    model.evaluate(u + probe * displacement_.col(column), at_rest, stageAt(column), moved);
     for (int node = 0; node < contact.size(); ++node) {
       const int dof = contact.dofs()[node];
       force_(node, column) = (moved.force[dof] - here.force[dof]) / probe;

@@ -418,21 +418,29 @@ CholeskyFactor::CholeskyFactor(const SparseMatrix& lower) {
   entries_.resize(written);
 }
 
-template <typename Entry>
-Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
-                             const Vector& rhs) const {
-  const int n = static_cast<int>(fill_order_.size());
-  Vector y(n);
-  for (int k = 0; k < n; ++k) y[k] = rhs[fill_order_[k]];
+namespace {
+/// A lane's zero: one right-hand side's value (double) or several side by side (an Eigen array).
+double zeroLane(double) { return 0.0; }
+template <int Width>
+Eigen::Array<double, Width, 1> zeroLane(const Eigen::Array<double, Width, 1>&) {
+  return Eigen::Array<double, Width, 1>::Zero();
+}
+}  // namespace
+
+template <typename Entry, typename Lane>
+void CholeskyFactor::sweepInPlace(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
+                                  Lane* y) const {
+  // Every operation is on whole lanes: each right-hand side in a lane of several sees the operations, in
+  // the order, that it sees alone (the core is built with -ffp-contract=off, so none is fused either).
   const int blocks = static_cast<int>(first_column_.size()) - 1;
   // One block's part of y, kept apart: the compiler cannot tell it from the rows below it.
-  double part[kWidestBlock];
+  Lane part[kWidestBlock];
   for (int b = 0; b < blocks; ++b) {  // L·y = P·rhs
     const int first = first_column_[b], width = first_column_[b + 1] - first;
     const double* diagonal = entries_.data() + diagonal_start_[b];
     for (int c = 0; c < width; ++c) part[c] = y[first + c];
     for (int c = 0; c < width; ++c) {
-      const double yc = (part[c] /= diagonal[c * width + c]);
+      const Lane yc = (part[c] /= diagonal[c * width + c]);
       for (int r = c + 1; r < width; ++r) part[r] -= diagonal[c * width + r] * yc;
       y[first + c] = yc;
     }
@@ -440,7 +448,7 @@ Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const std:
       const int w = widthOf(fixed_width, width);
       const Entry* below = below_entries.data() + below_start[b];
       for (int r = rows_start_[b]; r < rows_start_[b + 1]; ++r, below += w) {
-        double sum = 0.0;
+        Lane sum = zeroLane(part[0]);
         for (int c = 0; c < w; ++c) sum += below[c] * part[c];
         y[rows_[r]] -= sum;
       }
@@ -453,7 +461,7 @@ Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const std:
       const int w = widthOf(fixed_width, width);
       const Entry* below = below_entries.data() + below_start[b];
       for (int r = rows_start_[b]; r < rows_start_[b + 1]; ++r, below += w) {
-        const double yr = y[rows_[r]];
+        const Lane yr = y[rows_[r]];
         for (int c = 0; c < w; ++c) part[c] -= below[c] * yr;
       }
     });
@@ -463,12 +471,48 @@ Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const std:
       y[first + c] = part[c] /= diagonal[c * width + c];
     }
   }
+}
+
+template <typename Entry>
+Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
+                             const Vector& rhs) const {
+  const int n = static_cast<int>(fill_order_.size());
+  Vector y(n);
+  for (int k = 0; k < n; ++k) y[k] = rhs[fill_order_[k]];
+  sweepInPlace(below_entries, below_start, y.data());
   Vector solution(n);
   for (int k = 0; k < n; ++k) solution[fill_order_[k]] = y[k];
   return solution;
 }
 
 Vector CholeskyFactor::solve(const Vector& rhs) const { return sweep(entries_, below_start_, rhs); }
+
+Eigen::MatrixXd CholeskyFactor::solveColumns(const Eigen::MatrixXd& rhs) const {
+  Eigen::MatrixXd solution(rhs.rows(), rhs.cols());
+  const int columns = static_cast<int>(rhs.cols());
+  for (int first = 0; first < columns; first += kColumnsPerSweep) {
+    const int count = std::min(kColumnsPerSweep, columns - first);
+    if (count <= 4) {
+      sweepColumns<4>(rhs, first, count, solution);
+    } else if (count <= 8) {
+      sweepColumns<8>(rhs, first, count, solution);
+    } else {
+      sweepColumns<kColumnsPerSweep>(rhs, first, count, solution);
+    }
+  }
+  return solution;
+}
+
+template <int Width>
+void CholeskyFactor::sweepColumns(const Eigen::MatrixXd& rhs, int first, int count, Eigen::MatrixXd& solution) const {
+  // A row's values side by side, so that every operation runs across the columns (vector instructions).
+  using Lane = Eigen::Array<double, Width, 1>;
+  const int n = static_cast<int>(fill_order_.size());
+  std::vector<Lane> y(n, Lane::Zero());
+  for (int k = 0; k < n; ++k) y[k].head(count) = rhs.row(fill_order_[k]).segment(first, count).transpose();
+  sweepInPlace(entries_, below_start_, y.data());
+  for (int k = 0; k < n; ++k) solution.row(fill_order_[k]).segment(first, count) = y[k].head(count).transpose();
+}
 
 Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
   return sweep(below_single_, below_single_start_, rhs);

@@ -18,6 +18,13 @@ class CholeskyFactor {
   /// matrix⁻¹·rhs in double precision.
   Vector solve(const Vector& rhs) const;
 
+  /// solve() of each column of `rhs`, to the same bits: up to kColumnsPerSweep columns per sweep of the
+  /// factor, each with the same operations in the same order as solve() gives it.
+  Eigen::MatrixXd solveColumns(const Eigen::MatrixXd& rhs) const;
+  /// Columns that solveColumns carries through one sweep at most: right-hand sides that stay in cache at
+  /// the sizes that factor (0.5 MB at 57 × 31, 7 MB at 225 × 121).
+  static constexpr int kColumnsPerSweep = 16;
+
   /// matrix⁻¹·rhs through the factor's entries below its diagonal blocks rounded to single precision
   /// (sums in double): a relative error of about the condition number times 6·10⁻⁸. A solve streams the
   /// whole factor twice and waits on memory; 4 bytes per entry instead of 8 make it faster, and a
@@ -36,6 +43,16 @@ class CholeskyFactor {
   template <typename Entry>
   Vector sweep(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
                const Vector& rhs) const;
+  /// sweep() on y = P·rhs in place, whose rows are lanes: a double, or an Eigen array of several
+  /// right-hand sides' values.
+  template <typename Entry, typename Lane>
+  void sweepInPlace(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
+                    Lane* y) const;
+
+  /// solveColumns for `count` ≤ Width columns of `rhs` from `first`, into the same of `solution`: one sweep
+  /// of Width columns, those past `count` zero. With Width fixed, a row's sums stay in vector registers.
+  template <int Width>
+  void sweepColumns(const Eigen::MatrixXd& rhs, int first, int count, Eigen::MatrixXd& solution) const;
 
   /// The factor's row k belongs to the matrix's row fill_order_[k] (the fill-reducing ordering).
   std::vector<int> fill_order_;

@@ -121,12 +121,30 @@ Vector StaticSolver::reducedResponse(const Vector& reduced, bool single_precisio
   } else {
     solution = reduced;  // no free degree of freedom
   }
-  if (!spring_positions_.empty()) {
-    // (K + U·D·Uᵀ)⁻¹·f = x − W·(D⁻¹ + Uᵀ·W)⁻¹·Uᵀ·x with x = K⁻¹·f and W = K⁻¹·U.
-    const Eigen::VectorXd at_springs = entriesAt(solution, spring_positions_);
-    solution -= spring_response_ * capacitance_.solve(at_springs);
-  }
+  addSpringsTo(solution);
   return solution;
+}
+
+void StaticSolver::addSpringsTo(Vector& solution) const {
+  if (spring_positions_.empty()) return;
+  // (K + U·D·Uᵀ)⁻¹·f = x − W·(D⁻¹ + Uᵀ·W)⁻¹·Uᵀ·x with x = K⁻¹·f and W = K⁻¹·U.
+  const Eigen::VectorXd at_springs = entriesAt(solution, spring_positions_);
+  solution -= spring_response_ * capacitance_.solve(at_springs);
+}
+
+Eigen::MatrixXd StaticSolver::responses(const Eigen::MatrixXd& forces) const {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(forces.rows(), forces.cols());
+  if (!factor_) {
+    for (Eigen::Index c = 0; c < forces.cols(); ++c) out.col(c) = response(forces.col(c));
+    return out;
+  }
+  const Eigen::MatrixXd solved = factor_->solveColumns(rowsAt(forces, free_dofs_));
+  for (Eigen::Index c = 0; c < forces.cols(); ++c) {
+    Vector solution = solved.col(c);
+    addSpringsTo(solution);
+    for (std::size_t i = 0; i < free_dofs_.size(); ++i) out(free_dofs_[i], c) = solution[i];
+  }
+  return out;
 }
 
 Eigen::MatrixXd StaticSolver::unitResponses(const std::vector<int>& positions, bool single_precision) const {
