@@ -425,6 +425,10 @@ template <int Width>
 Eigen::Array<double, Width, 1> zeroLane(const Eigen::Array<double, Width, 1>&) {
   return Eigen::Array<double, Width, 1>::Zero();
 }
+/// Rows whose sums the forward sweep adds up together: four scalar chains; a lane of several right-hand
+/// sides is already several chains, and more of them would not fit the vector registers.
+template <typename Lane>
+constexpr int kRowsAtOnce = std::is_same_v<Lane, double> ? 4 : 1;
 }  // namespace
 
 template <typename Entry, typename Lane>
@@ -447,7 +451,19 @@ void CholeskyFactor::sweepInPlace(const std::vector<Entry>& below_entries, const
     forEachWidth(width, [&](auto fixed_width) {
       const int w = widthOf(fixed_width, width);
       const Entry* below = below_entries.data() + below_start[b];
-      for (int r = rows_start_[b]; r < rows_start_[b + 1]; ++r, below += w) {
+      // A row's sum is a chain of dependent additions; several rows at a time keep several chains in
+      // flight. Each still adds its terms in column order.
+      int r = rows_start_[b];
+      const int end = rows_start_[b + 1];
+      for (; r + kRowsAtOnce<Lane> <= end; r += kRowsAtOnce<Lane>, below += kRowsAtOnce<Lane> * w) {
+        Lane sum[kRowsAtOnce<Lane>];
+        for (Lane& each : sum) each = zeroLane(part[0]);
+        for (int c = 0; c < w; ++c) {
+          for (int k = 0; k < kRowsAtOnce<Lane>; ++k) sum[k] += below[k * w + c] * part[c];
+        }
+        for (int k = 0; k < kRowsAtOnce<Lane>; ++k) y[rows_[r + k]] -= sum[k];
+      }
+      for (; r < end; ++r, below += w) {
         Lane sum = zeroLane(part[0]);
         for (int c = 0; c < w; ++c) sum += below[c] * part[c];
         y[rows_[r]] -= sum;
@@ -467,8 +483,10 @@ void CholeskyFactor::sweepInPlace(const std::vector<Entry>& below_entries, const
     });
     const double* diagonal = entries_.data() + diagonal_start_[b];
     for (int c = width - 1; c >= 0; --c) {
-      for (int r = c + 1; r < width; ++r) part[c] -= diagonal[c * width + r] * part[r];
-      y[first + c] = part[c] /= diagonal[c * width + c];
+      // Summed apart from part[]: the compiler would otherwise store part[c] at every term.
+      Lane value = part[c];
+      for (int r = c + 1; r < width; ++r) value -= diagonal[c * width + r] * part[r];
+      y[first + c] = part[c] = value / diagonal[c * width + c];
     }
   }
 }
