@@ -27,6 +27,9 @@ def spacing(nodes_x):
     return SLIDER_LENGTH / (nodes_x - 1)
 
 
+DEFAULT_SPACING = spacing(int(_SCENE["lattice"]["nodes_x"]))  # m, the scene's own lattice
+
+
 def nucleation_length(normal_force):
     """m, L_b = G·D/(b·f0·σ̄) with G = 3E/8 (ν = 1/3) and σ̄ = F_Z/(L·B)."""
     geometry = _SCENE["geometry"]
@@ -215,7 +218,7 @@ def sections(data):
          "1 mm/s (docs/analysis.md, slip events). 57 × 31, to the first global event. Nucleation length "
          "L_b = G·D/(b·f0·σ̄) = %.1f mm at F_Z = %g N: %.1f lattice spacings." % (
              nucleation_length(DEFAULT_LOAD) * 1e3, DEFAULT_LOAD,
-             nucleation_length(DEFAULT_LOAD) / spacing(int(_SCENE["lattice"]["nodes_x"]))), "",
+             nucleation_length(DEFAULT_LOAD) / DEFAULT_SPACING), "",
          "*Rig*: %d precursors before the first global event at F_X/F_Z = %.4f (µ_s,macro; Amontons–Coulomb "
          "with µ_s = 0.4: 6 precursors, 0.2078)." % (len(pre), vr.f(g, "peak_shear_ratio")) if g else "no global event", ""]
 
@@ -258,11 +261,10 @@ def sections(data):
     # it turned) and where it ran slow; and whether the slip behind still ran while the front ran slow.
     prestress = onset_prestress("rate_state_normal_load", DEFAULT_RUN)
     times = event_nodes("rate_state_normal_load", DEFAULT_RUN, ("first_unstick_time_s", "last_slip_time_s"))
-    node_spacing = spacing(int(_SCENE["lattice"]["nodes_x"]))
     rows = []
     for i, (turn, run_slow) in transitions:
         profile = prestress.get(i, [])
-        fast, slow = (turn - 3 * node_spacing, turn), (turn, turn + run_slow + 0.5 * node_spacing)
+        fast, slow = (turn - 3 * DEFAULT_SPACING, turn), (turn, turn + run_slow + 0.5 * DEFAULT_SPACING)
         rows.append((i, turn, run_slow, mean_ratio(profile, *fast), mean_ratio(profile, *slow),
                      mean_ratio(profile, *fast, column=2), mean_ratio(profile, *slow, column=2),
                      still_slipping_behind(times.get(i, []), turn, turn + run_slow)))
