@@ -1,11 +1,12 @@
 // Google Benchmark of the explicit step, the hot loop: ns per node-step of the 2D lattice and per
 // block-step of the 1D chain, over system sizes, and the memory floor of a lattice step (stateStream,
 // and leapfrogStream for a scheme without stored accelerations), the divider's floor under the 2D
-// step (bondDividerFloor), and a static solve through the direct factor (staticSolve). Three cases separate causes: the
-// 1001 × 61 lattice has the rows of the 10⁶-node one with a state that fits the last-level cache (row width against
-// memory traffic); 32 × 32 and 33 × 31 have 10³ nodes each, but 32 × 32's runs of 31 bonds leave 7 over from whole
-// 8-wide vectors (the other lattices' runs are whole vectors but for one bond); and the 2-block chain's step is almost
-// all the step's fixed cost.
+// step (bondDividerFloor), a static solve through the direct factor (staticSolve), and the start-up's
+// static work: the stiffness matrix's assembly (stiffnessAssembly) and the whole solver (staticFactor).
+// Three cases separate causes: the 1001 × 61 lattice has the rows of the 10⁶-node one with a state that
+// fits the last-level cache (row width against memory traffic); 32 × 32 and 33 × 31 have 10³ nodes
+// each, but 32 × 32's runs of 31 bonds leave 7 over from whole 8-wide vectors (the other lattices' runs
+// are whole vectors but for one bond); and the 2-block chain's step is almost all the step's fixed cost.
 // Run: .build/devel/lib/friction_sim/bench_kernels
 #include <benchmark/benchmark.h>
 
@@ -236,6 +237,24 @@ void bondDividerFloor(benchmark::State& state) {
       nsPerNodeStep(static_cast<double>(nx * nz) * static_cast<double>(state.iterations()));
 }
 BENCHMARK(bondDividerFloor)->Unit(benchmark::kMicrosecond);
+
+/// The stiffness matrix's assembly, as a run's static solver starts with it (µs per matrix).
+void stiffnessAssembly(benchmark::State& state) {
+  const std::unique_ptr<Model> model =
+      buildModel(latticeScene(static_cast<int>(state.range(0)), static_cast<int>(state.range(1))));
+  for (auto _ : state) benchmark::DoNotOptimize(model->stiffnessMatrix());
+}
+BENCHMARK(stiffnessAssembly)->Args({57, 31})->Args({225, 121})->Unit(benchmark::kMicrosecond);
+
+/// A static solver's construction, as each run's start makes the loading solver's: the assembly, the
+/// ordering, the analysis and the numeric factorisation with its single-precision copy (µs per solver).
+void staticFactor(benchmark::State& state) {
+  const std::unique_ptr<Model> model =
+      buildModel(latticeScene(static_cast<int>(state.range(0)), static_cast<int>(state.range(1))));
+  model->disconnectPusher();
+  for (auto _ : state) benchmark::DoNotOptimize(StaticSolver(*model, model->blockedDofsDuringLoading()));
+}
+BENCHMARK(staticFactor)->Args({57, 31})->Args({225, 121})->Unit(benchmark::kMicrosecond);
 
 /// A static solve through the direct factor in double, as fast-forward makes them: the loading solver of
 /// the default slider's lattice, K⁻¹·f for a force on every free dof (µs per solve).
