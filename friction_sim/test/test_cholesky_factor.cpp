@@ -94,9 +94,13 @@ TEST(CholeskyFactor, SolvingColumnsTogetherGivesEachColumnsOwnSolveToTheBit) {
     for (const int columns : {37, 3}) {
       const Eigen::MatrixXd rhs = Eigen::MatrixXd::Random(lower.rows(), columns);
       const Eigen::MatrixXd together = factor.solveColumns(rhs);
+      const Eigen::MatrixXd together_single = factor.solveColumnsSinglePrecision(rhs);
       for (int c = 0; c < columns; ++c) {
         const Vector alone = factor.solve(rhs.col(c));
         EXPECT_EQ((together.col(c) - alone).cwiseAbs().maxCoeff(), 0.0) << lower.rows() << " column " << c;
+        const Vector alone_single = factor.solveSinglePrecision(rhs.col(c));
+        EXPECT_EQ((together_single.col(c) - alone_single).cwiseAbs().maxCoeff(), 0.0)
+            << lower.rows() << " column " << c << " in single precision";
       }
     }
   }
@@ -108,6 +112,7 @@ TEST(CholeskyFactor, SolvesWithoutUnknowns) {
   EXPECT_EQ(factor.solve(Vector()).size(), 0);
   EXPECT_EQ(factor.solveSinglePrecision(Vector()).size(), 0);
   EXPECT_EQ(factor.solveColumns(Eigen::MatrixXd(0, 3)).size(), 0);
+  EXPECT_EQ(factor.solveColumnsSinglePrecision(Eigen::MatrixXd(0, 3)).size(), 0);
 }
 
 TEST(CholeskyFactor, RefusesASingularMatrix) {

@@ -91,7 +91,7 @@ class StaticSolver {
   Vector response(const Vector& force, bool single_precision) const;
   /// Turns the factored stiffness's response on the free degrees of freedom into that of the stiffness
   /// with the springs of withAddedSprings (none: unchanged).
-  void addSpringsTo(Vector& solution) const;
+  void addSpringsTo(Eigen::Ref<Vector> solution) const;
   /// The responses (free dofs) to a unit force at each free position in `positions`, one column each.
   Eigen::MatrixXd unitResponses(const std::vector<int>& positions, bool single_precision) const;
   /// Turns `solution`, the factored stiffness's response on the free degrees of freedom, into that of the

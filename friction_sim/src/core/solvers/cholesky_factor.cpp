@@ -459,13 +459,13 @@ void CholeskyFactor::sweepInPlace(const std::vector<Entry>& below_entries, const
         Lane sum[kRowsAtOnce<Lane>];
         for (Lane& each : sum) each = zeroLane(part[0]);
         for (int c = 0; c < w; ++c) {
-          for (int k = 0; k < kRowsAtOnce<Lane>; ++k) sum[k] += below[k * w + c] * part[c];
+          for (int k = 0; k < kRowsAtOnce<Lane>; ++k) sum[k] += static_cast<double>(below[k * w + c]) * part[c];
         }
         for (int k = 0; k < kRowsAtOnce<Lane>; ++k) y[rows_[r + k]] -= sum[k];
       }
       for (; r < end; ++r, below += w) {
         Lane sum = zeroLane(part[0]);
-        for (int c = 0; c < w; ++c) sum += below[c] * part[c];
+        for (int c = 0; c < w; ++c) sum += static_cast<double>(below[c]) * part[c];
         y[rows_[r]] -= sum;
       }
     });
@@ -478,7 +478,7 @@ void CholeskyFactor::sweepInPlace(const std::vector<Entry>& below_entries, const
       const Entry* below = below_entries.data() + below_start[b];
       for (int r = rows_start_[b]; r < rows_start_[b + 1]; ++r, below += w) {
         const Lane yr = y[rows_[r]];
-        for (int c = 0; c < w; ++c) part[c] -= below[c] * yr;
+        for (int c = 0; c < w; ++c) part[c] -= static_cast<double>(below[c]) * yr;
       }
     });
     const double* diagonal = entries_.data() + diagonal_start_[b];
@@ -506,34 +506,46 @@ Vector CholeskyFactor::sweep(const std::vector<Entry>& below_entries, const std:
 Vector CholeskyFactor::solve(const Vector& rhs) const { return sweep(entries_, below_start_, rhs); }
 
 Eigen::MatrixXd CholeskyFactor::solveColumns(const Eigen::MatrixXd& rhs) const {
+  return sweepAllColumns(entries_, below_start_, rhs);
+}
+
+Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
+  return sweep(below_single_, below_single_start_, rhs);
+}
+
+Eigen::MatrixXd CholeskyFactor::solveColumnsSinglePrecision(const Eigen::MatrixXd& rhs) const {
+  return sweepAllColumns(below_single_, below_single_start_, rhs);
+}
+
+template <typename Entry>
+Eigen::MatrixXd CholeskyFactor::sweepAllColumns(const std::vector<Entry>& below_entries,
+                                                const std::vector<std::size_t>& below_start,
+                                                const Eigen::MatrixXd& rhs) const {
   Eigen::MatrixXd solution(rhs.rows(), rhs.cols());
   const int columns = static_cast<int>(rhs.cols());
   for (int first = 0; first < columns; first += kColumnsPerSweep) {
     const int count = std::min(kColumnsPerSweep, columns - first);
     if (count <= 4) {
-      sweepColumns<4>(rhs, first, count, solution);
+      sweepColumns<4>(below_entries, below_start, rhs, first, count, solution);
     } else if (count <= 8) {
-      sweepColumns<8>(rhs, first, count, solution);
+      sweepColumns<8>(below_entries, below_start, rhs, first, count, solution);
     } else {
-      sweepColumns<kColumnsPerSweep>(rhs, first, count, solution);
+      sweepColumns<kColumnsPerSweep>(below_entries, below_start, rhs, first, count, solution);
     }
   }
   return solution;
 }
 
-template <int Width>
-void CholeskyFactor::sweepColumns(const Eigen::MatrixXd& rhs, int first, int count, Eigen::MatrixXd& solution) const {
+template <int Width, typename Entry>
+void CholeskyFactor::sweepColumns(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
+                                  const Eigen::MatrixXd& rhs, int first, int count, Eigen::MatrixXd& solution) const {
   // A row's values side by side, so that every operation runs across the columns (vector instructions).
   using Lane = Eigen::Array<double, Width, 1>;
   const int n = static_cast<int>(fill_order_.size());
   std::vector<Lane> y(n, Lane::Zero());
   for (int k = 0; k < n; ++k) y[k].head(count) = rhs.row(fill_order_[k]).segment(first, count).transpose();
-  sweepInPlace(entries_, below_start_, y.data());
+  sweepInPlace(below_entries, below_start, y.data());
   for (int k = 0; k < n; ++k) solution.row(fill_order_[k]).segment(first, count) = y[k].head(count).transpose();
-}
-
-Vector CholeskyFactor::solveSinglePrecision(const Vector& rhs) const {
-  return sweep(below_single_, below_single_start_, rhs);
 }
 
 std::size_t CholeskyFactor::bytes() const {

@@ -30,6 +30,8 @@ class CholeskyFactor {
   /// whole factor twice and waits on memory; 4 bytes per entry instead of 8 make it faster, and a
   /// modified-Newton loop, whose residual is evaluated in double, converges to the same equilibrium.
   Vector solveSinglePrecision(const Vector& rhs) const;
+  /// solveSinglePrecision() of each column of `rhs`, to the same bits, as solveColumns() does solve().
+  Eigen::MatrixXd solveColumnsSinglePrecision(const Eigen::MatrixXd& rhs) const;
 
   /// Bytes held: the factor in double and its single-precision copy.
   std::size_t bytes() const;
@@ -49,10 +51,15 @@ class CholeskyFactor {
   void sweepInPlace(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
                     Lane* y) const;
 
-  /// solveColumns for `count` ≤ Width columns of `rhs` from `first`, into the same of `solution`: one sweep
-  /// of Width columns, those past `count` zero. With Width fixed, a row's sums stay in vector registers.
-  template <int Width>
-  void sweepColumns(const Eigen::MatrixXd& rhs, int first, int count, Eigen::MatrixXd& solution) const;
+  /// sweep() of each column of `rhs`, up to kColumnsPerSweep columns per sweep.
+  template <typename Entry>
+  Eigen::MatrixXd sweepAllColumns(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
+                                  const Eigen::MatrixXd& rhs) const;
+  /// sweep() of `count` ≤ Width columns of `rhs` from `first`, into the same of `solution`: one sweep of
+  /// Width columns, those past `count` zero. With Width fixed, a row's sums stay in vector registers.
+  template <int Width, typename Entry>
+  void sweepColumns(const std::vector<Entry>& below_entries, const std::vector<std::size_t>& below_start,
+                    const Eigen::MatrixXd& rhs, int first, int count, Eigen::MatrixXd& solution) const;
 
   /// The factor's row k belongs to the matrix's row fill_order_[k] (the fill-reducing ordering).
   std::vector<int> fill_order_;

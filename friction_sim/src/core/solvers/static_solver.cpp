@@ -125,7 +125,7 @@ Vector StaticSolver::reducedResponse(const Vector& reduced, bool single_precisio
   return solution;
 }
 
-void StaticSolver::addSpringsTo(Vector& solution) const {
+void StaticSolver::addSpringsTo(Eigen::Ref<Vector> solution) const {
   if (spring_positions_.empty()) return;
   // (K + U·D·Uᵀ)⁻¹·f = x − W·(D⁻¹ + Uᵀ·W)⁻¹·Uᵀ·x with x = K⁻¹·f and W = K⁻¹·U.
   const Eigen::VectorXd at_springs = entriesAt(solution, spring_positions_);
@@ -138,20 +138,18 @@ Eigen::MatrixXd StaticSolver::responses(const Eigen::MatrixXd& forces) const {
     for (Eigen::Index c = 0; c < forces.cols(); ++c) out.col(c) = response(forces.col(c));
     return out;
   }
-  const Eigen::MatrixXd solved = factor_->solveColumns(rowsAt(forces, free_dofs_));
-  for (Eigen::Index c = 0; c < forces.cols(); ++c) {
-    Vector solution = solved.col(c);
-    addSpringsTo(solution);
-    for (std::size_t i = 0; i < free_dofs_.size(); ++i) out(free_dofs_[i], c) = solution[i];
-  }
+  Eigen::MatrixXd solved = factor_->solveColumns(rowsAt(forces, free_dofs_));
+  for (Eigen::Index c = 0; c < forces.cols(); ++c) addSpringsTo(solved.col(c));
+  for (std::size_t i = 0; i < free_dofs_.size(); ++i) out.row(free_dofs_[i]) = solved.row(i);
   return out;
 }
 
 Eigen::MatrixXd StaticSolver::unitResponses(const std::vector<int>& positions, bool single_precision) const {
-  Eigen::MatrixXd responses(free_dofs_.size(), positions.size());
-  for (std::size_t c = 0; c < positions.size(); ++c) {
-    responses.col(c) = reducedResponse(Vector::Unit(free_dofs_.size(), positions[c]), single_precision);
-  }
+  Eigen::MatrixXd units = Eigen::MatrixXd::Zero(free_dofs_.size(), positions.size());
+  for (std::size_t c = 0; c < positions.size(); ++c) units(positions[c], c) = 1.0;
+  Eigen::MatrixXd responses =
+      single_precision ? factor_->solveColumnsSinglePrecision(units) : factor_->solveColumns(units);
+  for (Eigen::Index c = 0; c < responses.cols(); ++c) addSpringsTo(responses.col(c));
   return responses;
 }
 
