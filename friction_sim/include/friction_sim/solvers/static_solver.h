@@ -93,6 +93,7 @@ class StaticSolver {
   /// with the springs of withAddedSprings (none: unchanged).
   void addSpringsTo(Eigen::Ref<Vector> solution) const;
   /// The responses (free dofs) to a unit force at each free position in `positions`, one column each.
+  /// Needs the direct method's factor (its callers check for one).
   Eigen::MatrixXd unitResponses(const std::vector<int>& positions, bool single_precision) const;
   /// Turns `solution`, the factored stiffness's response on the free degrees of freedom, into that of the
   /// stiffness changed by `change` (those of its dofs that are free), by Woodbury's identity.

@@ -51,7 +51,7 @@ SparseMatrix freeStiffness(const Model& model, const std::vector<int>& lifted_no
 }
 
 /// `vector`'s entries at `indices`, in their order.
-Vector entriesAt(const Vector& vector, const std::vector<int>& indices) {
+Vector entriesAt(const Eigen::Ref<const Vector>& vector, const std::vector<int>& indices) {
   Vector out(indices.size());
   for (std::size_t i = 0; i < indices.size(); ++i) out[i] = vector[indices[i]];
   return out;
@@ -139,8 +139,10 @@ Eigen::MatrixXd StaticSolver::responses(const Eigen::MatrixXd& forces) const {
     return out;
   }
   Eigen::MatrixXd solved = factor_->solveColumns(rowsAt(forces, free_dofs_));
-  for (Eigen::Index c = 0; c < forces.cols(); ++c) addSpringsTo(solved.col(c));
-  for (std::size_t i = 0; i < free_dofs_.size(); ++i) out.row(free_dofs_[i]) = solved.row(i);
+  for (Eigen::Index c = 0; c < forces.cols(); ++c) {
+    addSpringsTo(solved.col(c));
+    for (std::size_t i = 0; i < free_dofs_.size(); ++i) out(free_dofs_[i], c) = solved(i, c);
+  }
   return out;
 }
 
