@@ -1,14 +1,11 @@
 // friction_run: runs a scene offline (no ROS master) to its stop condition and writes the results.
 // `friction_run --help` lists its arguments and the files it writes (help() below).
 #include <malloc.h>
-#include <sys/mman.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -30,28 +27,17 @@ constexpr int kBadCommandLine = 2;
 constexpr int kSceneRefused = 3;
 constexpr int kOutputUnwritable = 4;
 
-/// Puts the heap on the kernel's transparent huge pages where it allows them (its `madvise` mode, the
-/// default of Debian and Ubuntu). A run's start-up touches several MB, mostly the static factor, and in
-/// 4 KB pages each one costs a fault: at 57 × 31, 1307 faults and 14.3 ms before the first step, against
-/// 723 faults and 12.4 ms in huge pages; 113 × 61 and 225 × 121 start 1.28× and 1.26× as fast, with the
-/// same results and 1–2 MB more peak memory (2026-11-28, AMD EPYC family 25). glibc does the same under
-/// GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which a program cannot set for itself. So: allocations up to
-/// 32 MiB (glibc's own largest threshold) come from the heap, which grows 64 MiB at a time and is not
-/// trimmed below 128 MiB; its first growth is made now and advised. Larger arrays are mapped apart, as
-/// before. The growth only reserves addresses: pages are taken when first touched.
-void adviseHugePagesForTheHeap() {
-  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
+/// Lets a run reuse the memory it frees. A run allocates and frees arrays of 0.1 to 30 MB: the stiffness
+/// matrix, the factor's analysis and panels, the solves' vectors. glibc maps each one above 128 KiB
+/// afresh until its threshold adapts, and every fresh page is a fault (about 1300 in a 57 × 31
+/// start-up). Served from the heap, which keeps its free top up to 64 MiB, they reuse pages already
+/// touched. Arrays above 32 MiB (glibc's largest threshold) are still mapped apart and given back.
+/// Transparent huge pages under the heap (MADV_HUGEPAGE) saved more at 57 × 31, but on the virtual
+/// machine measured one 225 × 121 start-up in three took 200 ms longer, with no compaction recorded.
+void reuseFreedMemory() {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TOP_PAD, 64 << 20);
-  mallopt(M_TRIM_THRESHOLD, 128 << 20);
-  const auto heap_start = reinterpret_cast<std::uintptr_t>(sbrk(0));
-  void* volatile growth = std::malloc(256 << 10);  // volatile: a malloc freed unused may be left out
-  std::free(growth);
-  const auto heap_end = reinterpret_cast<std::uintptr_t>(sbrk(0));
-  const std::uintptr_t aligned_start = (heap_start + kHugePage - 1) & ~(kHugePage - 1);
-  if (heap_end > aligned_start) {
-    madvise(reinterpret_cast<void*>(aligned_start), heap_end - aligned_start, MADV_HUGEPAGE);
-  }
+  mallopt(M_TRIM_THRESHOLD, 64 << 20);
+  mallopt(M_TOP_PAD, 16 << 20);
 }
 
 int refuseOutput(const std::string& out_dir, const std::string& reason) {
@@ -251,7 +237,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  adviseHugePagesForTheHeap();
+  reuseFreedMemory();
   try {
     return run(argc, argv);
   } catch (const friction::ConfigError& error) {
