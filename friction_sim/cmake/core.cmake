@@ -12,7 +12,8 @@ find_library(AMD_LIBRARY amd REQUIRED)
 # Eigen's and AMD's headers for every target from here on (the core's solvers and their tests use both).
 include_directories(SYSTEM ${EIGEN3_INCLUDE_DIR} ${AMD_INCLUDE_DIR})
 
-add_library(friction_sim_core
+# The core compiled once: into the library, and into friction_run, which links it statically (below).
+add_library(friction_sim_core_objects OBJECT
   src/core/contact/contact_interface.cpp
   src/core/contact/friction_law.cpp
   src/core/instruments/frame_event_detector.cpp
@@ -40,31 +41,60 @@ add_library(friction_sim_core
   src/core/solvers/static_solver.cpp
   src/core/stage/stage.cpp
 )
-# Public headers in include/friction_sim/<room>/, the core's own next to its sources (src/core/<room>/).
-target_include_directories(friction_sim_core PUBLIC include PRIVATE src/core)
+set_target_properties(friction_sim_core_objects PROPERTIES POSITION_INDEPENDENT_CODE ON)
+# What compiling against the core needs: its public headers in include/friction_sim/<room>/ (the core's
+# own are next to its sources, src/core/<room>/), yaml-cpp's, and the flags below.
+add_library(friction_sim_core_interface INTERFACE)
+target_include_directories(friction_sim_core_interface INTERFACE
+  include $<TARGET_PROPERTY:yaml-cpp,INTERFACE_INCLUDE_DIRECTORIES>)
+target_link_libraries(friction_sim_core_objects PUBLIC friction_sim_core_interface)
+target_include_directories(friction_sim_core_objects PRIVATE src/core)
 # errno from sqrt is never read: without it the bond loops vectorise. No FMA contraction: a vector
 # loop's peeled and main parts would otherwise round differently depending on where a buffer happens
 # to be aligned, and two runs of one scene would drift apart (determinism is tested). No semantic
 # interposition: calls within a source file (the step's small calls) need not go through the PLT and
 # can be inlined; nobody replaces the core's functions at load time.
-target_compile_options(friction_sim_core PRIVATE -fno-math-errno -ffp-contract=off -fno-semantic-interposition)
+target_compile_options(friction_sim_core_objects PRIVATE -fno-math-errno -ffp-contract=off
+  -fno-semantic-interposition ${OpenMP_CXX_FLAGS})
 # The rig is built where it runs: use the machine's full SIMD width (AVX2/AVX-512 halves the step time).
 option(FRICTION_SIM_NATIVE "Compile the physics core for the building machine's CPU (-march=native)" ON)
 if(FRICTION_SIM_NATIVE)
-  target_compile_options(friction_sim_core PUBLIC -march=native)
+  target_compile_options(friction_sim_core_interface INTERFACE -march=native)
 endif()
 # The friction loop records each node's force as it turns it into an acceleration; GCC would split
 # that record off into a memcpy call, a second pass over the forces and a call per strip.
 set_source_files_properties(src/core/contact/contact_interface.cpp PROPERTIES COMPILE_OPTIONS -fno-tree-loop-distribute-patterns)
-target_link_libraries(friction_sim_core PUBLIC yaml-cpp ${AMD_LIBRARY} PRIVATE OpenMP::OpenMP_CXX)
 # OpenMP is for the lattice's own threads: Eigen's dense products (the factorisation's updates) stay on
 # the calling thread, whatever OMP_NUM_THREADS says (two threads cost more than they gave on panels this small).
-target_compile_definitions(friction_sim_core PUBLIC EIGEN_DONT_PARALLELIZE)
+target_compile_definitions(friction_sim_core_interface INTERFACE EIGEN_DONT_PARALLELIZE)
+
+add_library(friction_sim_core $<TARGET_OBJECTS:friction_sim_core_objects>)
+target_link_libraries(friction_sim_core PUBLIC friction_sim_core_interface yaml-cpp ${AMD_LIBRARY}
+  PRIVATE OpenMP::OpenMP_CXX)
 # Calls between the core's own source files bind inside the library too, without the PLT.
 target_link_options(friction_sim_core PRIVATE -Wl,-Bsymbolic-functions)
 
+# friction_run starts a process per run, and loading shared libraries was a tenth of a 57 × 31 run's
+# time before its first step: `friction_run --help` took 2.1 ms linked to the core's library, 1.1 ms
+# with the core, libstdc++, libgcc, libgomp, yaml-cpp and AMD linked in (an empty C program 0.7 ms;
+# 2026-11-28, AMD EPYC family 25). Only the C library and libm stay shared. Where a static archive is
+# missing, or under the sanitizers (whose runtimes want the shared C++ library), it links as the nodes do.
 add_executable(friction_run src/tools/friction_run.cpp)
-target_link_libraries(friction_run friction_sim_core)
+find_library(YAML_CPP_ARCHIVE libyaml-cpp.a)
+find_library(AMD_ARCHIVE libamd.a)
+find_library(SUITESPARSECONFIG_ARCHIVE libsuitesparseconfig.a)
+# The compiler's own archive of libgomp (it answers the bare name when it has none).
+execute_process(COMMAND ${CMAKE_CXX_COMPILER} -print-file-name=libgomp.a OUTPUT_VARIABLE GOMP_ARCHIVE
+  OUTPUT_STRIP_TRAILING_WHITESPACE)
+find_package(Threads REQUIRED)
+if(YAML_CPP_ARCHIVE AND AMD_ARCHIVE AND SUITESPARSECONFIG_ARCHIVE AND IS_ABSOLUTE "${GOMP_ARCHIVE}"
+   AND NOT FRICTION_SIM_SANITIZE)
+  target_sources(friction_run PRIVATE $<TARGET_OBJECTS:friction_sim_core_objects>)
+  target_link_libraries(friction_run friction_sim_core_interface ${YAML_CPP_ARCHIVE} ${AMD_ARCHIVE}
+    ${SUITESPARSECONFIG_ARCHIVE} ${GOMP_ARCHIVE} Threads::Threads ${CMAKE_DL_LIBS} -static-libstdc++ -static-libgcc)
+else()
+  target_link_libraries(friction_run friction_sim_core)
+endif()
 
 # The core's unit tests (GoogleTest), run by catkin or by CTest.
 set(FRICTION_SIM_CORE_TESTS

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """The three catkin packages as catkin_lint reads them: no problem at -W1 (errors and warnings), so that
 they build and install the way catkin users expect (dependencies exported, everything installed); and
-the built programs look for their libraries only where their RUNPATH names."""
+the built programs look for their libraries only where their RUNPATH names, and friction_run needs none
+of them."""
 import os
 import re
 import subprocess
@@ -21,14 +22,24 @@ class PackagingTest(unittest.TestCase):
         self.assertIn("checked 3 packages and found 0 problems", done.stderr + done.stdout, done.stdout + done.stderr)
 
     def test_no_library_is_looked_for_in_the_working_directory(self):
-        # An empty RUNPATH entry means the working directory to the loader.
-        dynamic = subprocess.run(["readelf", "-d", built.friction_run()], capture_output=True, text=True,
+        # An empty RUNPATH entry means the working directory to the loader. The simulator node links the
+        # core's library and ROS's.
+        dynamic = subprocess.run(["readelf", "-d", built.program("rig_simulator")], capture_output=True, text=True,
                                  check=True).stdout
         paths = re.findall(r"\((?:RUNPATH|RPATH)\)\s+Library r(?:un)?path: \[(.*)\]", dynamic)
         self.assertTrue(paths, dynamic)
         for path in paths:
             self.assertNotIn("", path.split(":"), path)
 
+    def test_friction_run_loads_only_the_c_library(self):
+        # A process per run: the core, libstdc++, yaml-cpp, AMD and libgomp are linked in (cmake/core.cmake).
+        dynamic = subprocess.run(["readelf", "-d", built.friction_run()], capture_output=True, text=True,
+                                 check=True).stdout
+        needed = re.findall(r"\(NEEDED\)\s+Shared library: \[(.*)\]", dynamic)
+        self.assertTrue(needed, dynamic)
+        for name in needed:  # the C library, its maths and the loader
+            self.assertRegex(name, r"^(libc|libm|libmvec)\.so\.\d+$|^ld-linux", dynamic)
+        self.assertNotIn("RUNPATH", dynamic)
 
 if __name__ == "__main__":
     rosunit.unitrun("friction_sim", "packaging", PackagingTest)
