@@ -429,6 +429,18 @@ Eigen::Array<double, Width, 1> zeroLane(const Eigen::Array<double, Width, 1>&) {
 /// sides is already several chains, and more of them would not fit the vector registers.
 template <typename Lane>
 constexpr int kRowsAtOnce = std::is_same_v<Lane, double> ? 4 : 1;
+
+/// Subtracts from y, at rows[0 ... Rows), each row's sum over the block's w columns of its entries in
+/// `below` (row-major) times part[]: each row's terms added in column order, the Rows chains side by side.
+template <int Rows, typename Entry, typename Lane>
+void subtractRowSums(const Entry* below, int w, const Lane* part, const int* rows, Lane* y) {
+  Lane sum[Rows];
+  for (Lane& each : sum) each = zeroLane(part[0]);
+  for (int c = 0; c < w; ++c) {
+    for (int k = 0; k < Rows; ++k) sum[k] += static_cast<double>(below[k * w + c]) * part[c];
+  }
+  for (int k = 0; k < Rows; ++k) y[rows[k]] -= sum[k];
+}
 }  // namespace
 
 template <typename Entry, typename Lane>
@@ -456,18 +468,9 @@ void CholeskyFactor::sweepInPlace(const std::vector<Entry>& below_entries, const
       int r = rows_start_[b];
       const int end = rows_start_[b + 1];
       for (; r + kRowsAtOnce<Lane> <= end; r += kRowsAtOnce<Lane>, below += kRowsAtOnce<Lane> * w) {
-        Lane sum[kRowsAtOnce<Lane>];
-        for (Lane& each : sum) each = zeroLane(part[0]);
-        for (int c = 0; c < w; ++c) {
-          for (int k = 0; k < kRowsAtOnce<Lane>; ++k) sum[k] += static_cast<double>(below[k * w + c]) * part[c];
-        }
-        for (int k = 0; k < kRowsAtOnce<Lane>; ++k) y[rows_[r + k]] -= sum[k];
+        subtractRowSums<kRowsAtOnce<Lane>>(below, w, part, rows_.data() + r, y);
       }
-      for (; r < end; ++r, below += w) {
-        Lane sum = zeroLane(part[0]);
-        for (int c = 0; c < w; ++c) sum += static_cast<double>(below[c]) * part[c];
-        y[rows_[r]] -= sum;
-      }
+      for (; r < end; ++r, below += w) subtractRowSums<1>(below, w, part, rows_.data() + r, y);
     });
   }
   for (int b = blocks - 1; b >= 0; --b) {  // Lᵀ·z = y
