@@ -45,8 +45,7 @@ set_target_properties(friction_sim_core_objects PROPERTIES POSITION_INDEPENDENT_
 # What compiling against the core needs: its public headers in include/friction_sim/<room>/ (the core's
 # own are next to its sources, src/core/<room>/), yaml-cpp's, and the flags below.
 add_library(friction_sim_core_interface INTERFACE)
-target_include_directories(friction_sim_core_interface INTERFACE
-  include $<TARGET_PROPERTY:yaml-cpp,INTERFACE_INCLUDE_DIRECTORIES>)
+target_include_directories(friction_sim_core_interface INTERFACE include ${YAML_CPP_INCLUDE_DIR})
 target_link_libraries(friction_sim_core_objects PUBLIC friction_sim_core_interface)
 target_include_directories(friction_sim_core_objects PRIVATE src/core)
 # errno from sqrt is never read: without it the bond loops vectorise. No FMA contraction: a vector
