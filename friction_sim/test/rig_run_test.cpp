@@ -679,7 +679,6 @@ TEST(KillRun, BagIsReadableAndHoldsEverythingUpToTheKill) {
 void watchFullRun(ros::NodeHandle& nh) {
   auto rig = std::make_shared<ros::NodeHandle>("/rig");
   std::vector<ros::Subscriber> subs;
-  subs.push_back(keep(nh, "/rig/slip_events", g_seen.events));
   subs.push_back(keep(nh, "/rig/precursor_detector/precursor_points", g_seen.live_points));
   subs.push_back(keep(nh, "/replay/precursor_detector/precursor_points", g_seen.replay_points));
   subs.push_back(keep(nh, "/rig/precursor_detector/slip_events", g_seen.live_detector_events));
@@ -698,9 +697,9 @@ void watchFullRun(ros::NodeHandle& nh) {
         ++g_seen.lattice_snapshots;
         g_seen.last_lattice = *m;
       }));
-  // Bad commands to the rig while it waits for its controller (5 s here: with fast-forward the run itself
-  // is over in a tenth of a second, and calls made while it ran could come after it had ended); then a
-  // bad scene and a bad parameter for a second simulator.
+  // Bad commands to the rig while it waits at t = 0 for this test's subscription to its slip events
+  // (full_run.test): with fast-forward the run itself is over in a tenth of a second, and calls made while
+  // it ran could come after it had ended. Then a bad scene and a bad parameter for a second simulator.
   ros::service::waitForService("/rig/send_command", ros::Duration(60.0));
   ros::ServiceClient client = nh.serviceClient<friction_msgs::SendStageCommand>("/rig/send_command");
   for (auto [mode, speed, load] :
@@ -716,7 +715,9 @@ void watchFullRun(ros::NodeHandle& nh) {
   ros::master::V_TopicInfo topics;
   ros::master::getTopics(topics);
   for (const auto& topic : topics) g_seen.topic_types[topic.name] = topic.datatype;
+  ros::spinOnce();
   g_seen.time_after_bad_commands = g_seen.last_stage_time;
+  subs.push_back(keep(nh, "/rig/slip_events", g_seen.events));
   std::string bad_scene = "/tmp/friction_rig_bad_scene.yaml";
   std::FILE* file = std::fopen(bad_scene.c_str(), "w");
   std::fputs("friction: {kinetic_coefficient: 0.9}\npusher: {height: 1.0}\n", file);
