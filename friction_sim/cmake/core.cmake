@@ -56,6 +56,9 @@ target_include_directories(friction_sim_core_objects PRIVATE src/core)
 target_compile_options(friction_sim_core_objects PRIVATE -fno-math-errno -ffp-contract=off
   -fno-semantic-interposition ${OpenMP_CXX_FLAGS})
 # The rig is built where it runs: use the machine's full SIMD width (AVX2/AVX-512 halves the step time).
+# AVX-512 rounds Eigen's sums and dense products otherwise than AVX2 (another packet width), so the pinned
+# results hold bit for bit on AVX2 builds only (test_determinism.cpp); it is kept for its speed: without
+# it, 12000 steps of 449 x 241 took 10.8 s instead of 7.0 s on an AVX-512 host (2026-11-28, side by side).
 option(FRICTION_SIM_NATIVE "Compile the physics core for the building machine's CPU (-march=native)" ON)
 if(FRICTION_SIM_NATIVE)
   target_compile_options(friction_sim_core_interface INTERFACE -march=native)
