@@ -118,6 +118,10 @@ class BackgroundCommand {
   pid_t pid_;
 };
 
+/// A path in /tmp named after this test node (`what` appended): full_run and full_run_rate_state may run
+/// at the same time.
+std::string ownTemporaryPath(const std::string& what) { return "/tmp/" + ros::this_node::getName().substr(1) + what; }
+
 /// The whole text of a file ("" if it cannot be read).
 std::string readFile(const std::string& path) {
   std::ifstream file(path);
@@ -216,7 +220,7 @@ class StandInSimulator {
 
 /// A controller given a bad protocol, against a simulator that is only a stop service.
 void runRefusedProtocol() {
-  const std::string protocol = "/tmp/friction_rig_bad_protocol.yaml";
+  const std::string protocol = ownTemporaryPath("_bad_protocol.yaml");
   std::FILE* file = std::fopen(protocol.c_str(), "w");
   std::fputs("steps:\n  - {action: drive, speed: .nan, duration: -1.0}\nend: {global_events: 1}\n", file);
   std::fclose(file);
@@ -646,7 +650,7 @@ TEST(FullRun, LiveRunEqualsTheOfflineRunOfTheSameSceneAndCommands) {
   // rig_report's table from the bag is the offline runner's events.csv, to the last digit.
   std::ostringstream offline_table;
   writeEventsCsv(offline_table, offline.events(), offline.scene());
-  const std::string out = "/tmp/" + ros::this_node::getName().substr(1) + "_report";
+  const std::string out = ownTemporaryPath("_report");
   std::string output;
   ASSERT_EQ(runCommand("rosrun friction_sim rig_report " + g_bag + " --out " + out, output), 0) << output;
   EXPECT_EQ(readFile(out + "/events.csv"), offline_table.str());
@@ -717,8 +721,15 @@ void watchFullRun(ros::NodeHandle& nh) {
   for (const auto& topic : topics) g_seen.topic_types[topic.name] = topic.datatype;
   ros::spinOnce();
   g_seen.time_after_bad_commands = g_seen.last_stage_time;
+  // Every other topic connected before the subscription that starts the run.
+  waitFor(
+      [&subs] {
+        return std::all_of(subs.begin(), subs.end(),
+                           [](const ros::Subscriber& sub) { return sub.getNumPublishers() > 0; });
+      },
+      240.0);
   subs.push_back(keep(nh, "/rig/slip_events", g_seen.events));
-  std::string bad_scene = "/tmp/friction_rig_bad_scene.yaml";
+  const std::string bad_scene = ownTemporaryPath("_bad_scene.yaml");
   std::FILE* file = std::fopen(bad_scene.c_str(), "w");
   std::fputs("friction: {kinetic_coefficient: 0.9}\npusher: {height: 1.0}\n", file);
   std::fclose(file);

@@ -32,13 +32,20 @@ class ContactMonitorTest(unittest.TestCase):
         deadline = time.time() + 60.0
         while listening.get_num_connections() == 0 and time.time() < deadline:
             time.sleep(0.05)
+        self.assertGreater(listening.get_num_connections(), 0, "never connected to contact_monitor's shares")
         rospy.Subscriber("/rig/slip_events", SlipEvent,
                          lambda event: global_events.append(event) if event.global_event else None, queue_size=1000)
         rospy.Subscriber("/rig/interface", InterfaceState, on_frame, queue_size=100000)
         deadline = time.time() + 200.0
         while len(global_events) < 2 and time.time() < deadline:
             time.sleep(0.1)
-        time.sleep(2.0)  # the last frames and their shares
+        # The last frames' shares: the node may lag behind the simulator.
+        deadline = time.time() + 120.0
+        while time.time() < deadline:
+            with lock:
+                if sorted(shares) == sorted(frames) and all(len(shares[t]) == len(f) for t, f in frames.items()):
+                    break
+            time.sleep(0.1)
         self.assertEqual(len(global_events), 2)
         with lock:
             self.assertGreater(sum(len(states) for states in frames.values()), 100)
