@@ -86,7 +86,12 @@ class RvizScreenshot(unittest.TestCase):
         cls.log = open(os.path.join(cls.out, "rviz_output.txt"), "w+")
         cls.rviz = subprocess.Popen(["rviz", "-d", config], stdout=cls.log, stderr=subprocess.STDOUT)
         cls.sliding_frame = None
-        rospy.wait_for_service("/rig/pause", timeout=60)
+        cls.last_frame = None
+        cls.watching = False
+        # Listening from the start: the rig runs once rviz and this test listen to its camera
+        # (rviz_screenshot.test), so a slow start of either misses nothing.
+        rospy.Subscriber("/rig/interface", InterfaceState, cls.on_frame, queue_size=1)
+        rospy.wait_for_service("/rig/pause", timeout=240)
         cls.pause = rospy.ServiceProxy("/rig/pause", SetBool, persistent=True)
         # rviz starts, loads the plugins and draws the loading slider with its interface band.
         cls.stuck = screenshot_once(os.path.join(cls.out, "stuck.png"),
@@ -98,8 +103,7 @@ class RvizScreenshot(unittest.TestCase):
         # Pause the rig from the frame callback itself, while the event is still under way. On a loaded
         # machine the pause can land after the event has ended (the simulator catches up on its pace):
         # then the last frame, the one the display shows, is stuck again, and the rig runs on to the next.
-        cls.last_frame = None
-        rospy.Subscriber("/rig/interface", InterfaceState, cls.on_frame, queue_size=1)
+        cls.watching = True
         deadline = time.time() + 240
         while time.time() < deadline:
             if cls.sliding_frame is not None:
@@ -120,7 +124,7 @@ class RvizScreenshot(unittest.TestCase):
     @classmethod
     def on_frame(cls, msg):
         cls.last_frame = msg
-        if cls.sliding_frame is None and sliding_nodes(msg) >= 3:
+        if cls.watching and cls.sliding_frame is None and sliding_nodes(msg) >= 3:
             cls.pause(True)
             cls.sliding_frame = msg
 
