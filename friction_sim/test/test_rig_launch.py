@@ -68,7 +68,7 @@ class SlowRun:
         self.started = threading.Event()
         self.reader = threading.Thread(target=self.read, daemon=True)
         self.reader.start()
-        self.started.wait(timeout=60)
+        self.started.wait(timeout=240)
         self.simulator = descendant_named(self.process.pid, "rig_simulator") if self.started.is_set() else None
         return self
 
@@ -433,7 +433,8 @@ class RigLaunchStatusTest(unittest.TestCase):
 
     def test_a_subscriber_that_comes_late_sees_the_run_from_its_first_frame(self):
         process = subprocess.Popen([RIG_LAUNCH, RIG, "scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false",
-                                    "wait_for_subscribers:=interface"], stdout=subprocess.PIPE,
+                                    "wait_for_subscribers:=interface", "subscriber_timeout:=240"],
+                                   stdout=subprocess.PIPE,
                                    stderr=subprocess.STDOUT, text=True)
         self.addCleanup(lambda: process.poll() is None and process.kill())
         first_lines = [process.stdout.readline() for _ in range(3)]

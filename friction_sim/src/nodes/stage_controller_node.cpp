@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
     // A simulator started paused waits for this node's protocol: end its run, as failed, rather than
     // leave it waiting.
     ros::NodeHandle nh;
-    friction::endSimulatorRun(nh, "abort", ros::WallDuration(10.0));
+    friction::endSimulatorRun(nh, "abort", ros::WallDuration(60.0));
     return 2;
   }
   return 0;
