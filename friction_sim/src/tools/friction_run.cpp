@@ -1,11 +1,14 @@
 // friction_run: runs a scene offline (no ROS master) to its stop condition and writes the results.
 // `friction_run --help` lists its arguments and the files it writes (help() below).
 #include <malloc.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -27,17 +30,30 @@ constexpr int kBadCommandLine = 2;
 constexpr int kSceneRefused = 3;
 constexpr int kOutputUnwritable = 4;
 
-/// Lets a run reuse the memory it frees. A run allocates and frees arrays of 0.1 to 30 MB: the stiffness
-/// matrix, the factor's analysis and panels, the solves' vectors. glibc maps each one above 128 KiB
-/// afresh until its threshold adapts, and every fresh page is a fault (about 1300 in a 57 × 31
-/// start-up). Served from the heap, which keeps its free top up to 64 MiB, they reuse pages already
-/// touched. Arrays above 32 MiB (glibc's largest threshold) are still mapped apart and given back.
-/// Transparent huge pages under the heap (MADV_HUGEPAGE) saved more at 57 × 31, but on the virtual
-/// machine measured one 225 × 121 start-up in three took 200 ms longer, with no compaction recorded.
-void reuseFreedMemory() {
+/// Lets a run reuse the memory it frees, on transparent huge pages. A run allocates and frees arrays of
+/// 0.1 to 30 MB: the stiffness matrix, the factor's analysis and panels, the solves' vectors. glibc maps
+/// each one above 128 KiB afresh until its threshold adapts, and every fresh page is a fault (about 1040
+/// in a 57 × 31 start-up). Served from the heap, they reuse pages already touched; arrays above 32 MiB
+/// (glibc's largest threshold) are still mapped apart. The heap's first growth reserves 256 MiB of
+/// addresses (pages are taken only when touched), advised for huge pages where the kernel allows them
+/// (its `madvise` mode, Debian's and Ubuntu's default): a fault then brings 2 MiB. glibc does the same
+/// under GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which a program cannot set for itself. The time before
+/// the first step, interleaved against 4 KiB pages (2026-11-28): on an AMD EPYC of family 26, where a
+/// fresh page costs 10–14 µs, 225 × 121 335 → 164 ms; on one of family 25, 1.26× at 113 × 61 and
+/// 225 × 121, though one 225 × 121 start-up in three there took 200 ms longer.
+void reuseFreedMemoryOnHugePages() {
+  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TRIM_THRESHOLD, 64 << 20);
-  mallopt(M_TOP_PAD, 16 << 20);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+  mallopt(M_TOP_PAD, 256 << 20);
+  const auto heap_start = reinterpret_cast<std::uintptr_t>(sbrk(0));
+  void* volatile growth = std::malloc(256 << 10);  // volatile: a malloc freed unused may be left out
+  std::free(growth);
+  const auto heap_end = reinterpret_cast<std::uintptr_t>(sbrk(0));
+  const std::uintptr_t aligned_start = (heap_start + kHugePage - 1) & ~(kHugePage - 1);
+  if (heap_end > aligned_start) {
+    madvise(reinterpret_cast<void*>(aligned_start), heap_end - aligned_start, MADV_HUGEPAGE);
+  }
 }
 
 int refuseOutput(const std::string& out_dir, const std::string& reason) {
@@ -237,7 +253,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  reuseFreedMemory();
+  reuseFreedMemoryOnHugePages();
   try {
     return run(argc, argv);
   } catch (const friction::ConfigError& error) {
