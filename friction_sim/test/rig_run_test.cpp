@@ -57,6 +57,7 @@ struct Observed {
   std::vector<friction_msgs::PrecursorPoint> live_points, replay_points;
   std::vector<friction_msgs::SlipEvent> live_detector_events, replay_detector_events;
   std::vector<double> clock, load_cell_stamps;
+  bool subscriptions_connected = false;  ///< each of the test's subscriptions heard its publisher
   int gauge_profiles = 0;
   double last_stage_time = 0.0;
   int stage_states = 0;
@@ -118,8 +119,8 @@ class BackgroundCommand {
   pid_t pid_;
 };
 
-/// A path in /tmp named after this test node (`what` appended): full_run and full_run_rate_state may run
-/// at the same time.
+/// A path in /tmp named after this test node (`what` appended): full_run and full_run_rate_state run at
+/// the same time under `run_tests -j2`.
 std::string ownTemporaryPath(const std::string& what) { return "/tmp/" + ros::this_node::getName().substr(1) + what; }
 
 /// The whole text of a file ("" if it cannot be read).
@@ -365,6 +366,7 @@ void expectLoadCellsEvery100Microseconds() {
 }
 
 TEST(FullRun, TopicsHaveTheirTypesAndSimulatedTimeStamps) {
+  EXPECT_TRUE(g_seen.subscriptions_connected);
   EXPECT_EQ(g_seen.topic_types["/rig/load_cells"], "geometry_msgs/WrenchStamped");
   EXPECT_EQ(g_seen.topic_types["/rig/interface"], "friction_msgs/InterfaceState");
   EXPECT_EQ(g_seen.topic_types["/rig/strain_gauges"], "friction_msgs/StrainGaugeProfile");
@@ -578,6 +580,7 @@ TEST(FullRun, BagHoldsTheSceneAsRunFirstAndAgainWithTheProtocolsEnd) {
 }
 
 void expectPointsMatchEvents(const std::vector<friction_msgs::PrecursorPoint>& points) {
+  ASSERT_FALSE(g_seen.events.empty());
   ASSERT_EQ(points.size(), g_seen.events.size());
   for (std::size_t e = 0; e < points.size(); ++e) {
     const auto& event = g_seen.events[e];
@@ -722,7 +725,7 @@ void watchFullRun(ros::NodeHandle& nh) {
   ros::spinOnce();
   g_seen.time_after_bad_commands = g_seen.last_stage_time;
   // Every other topic connected before the subscription that starts the run.
-  waitFor(
+  g_seen.subscriptions_connected = waitFor(
       [&subs] {
         return std::all_of(subs.begin(), subs.end(),
                            [](const ros::Subscriber& sub) { return sub.getNumPublishers() > 0; });

@@ -39,12 +39,19 @@ class ContactMonitorTest(unittest.TestCase):
         deadline = time.time() + 200.0
         while len(global_events) < 2 and time.time() < deadline:
             time.sleep(0.1)
-        # The last frames' shares: the node may lag behind the simulator.
+        # The last frames' shares: the node may lag behind the simulator. Done once every frame has its
+        # shares and no frame has come for a second.
         deadline = time.time() + 120.0
+        seen, quiet_since = -1, time.time()
         while time.time() < deadline:
             with lock:
-                if sorted(shares) == sorted(frames) and all(len(shares[t]) == len(f) for t, f in frames.items()):
-                    break
+                count = sum(len(states) for states in frames.values())
+                caught_up = sorted(shares) == sorted(frames) and all(len(shares[t]) == len(f)
+                                                                     for t, f in frames.items())
+            if count != seen:
+                seen, quiet_since = count, time.time()
+            elif caught_up and time.time() - quiet_since > 1.0:
+                break
             time.sleep(0.1)
         self.assertEqual(len(global_events), 2)
         with lock:
