@@ -16,6 +16,7 @@
 
 #include "friction_sim/instruments/results_io.h"
 #include "friction_sim/run/run_driver.h"
+#include "friction_sim/scene/loading_protocol.h"
 #include "test_helpers.h"
 
 namespace friction::testing {
@@ -55,11 +56,7 @@ std::string readFile(const std::string& path) {
 std::vector<std::vector<std::string>> csvCells(const std::string& text) {
   std::vector<std::vector<std::string>> rows;
   std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);) {
-    std::vector<std::string>& row = rows.emplace_back();
-    std::istringstream cells(line);
-    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(cell);
-  }
+  for (std::string line; std::getline(lines, line);) rows.push_back(splitCsvLine(line));
   return rows;
 }
 
