@@ -39,28 +39,30 @@ constexpr int kOutputUnwritable = 4;
 /// (its `madvise` mode, Debian's and Ubuntu's default): a fault then brings 2 MiB. Later growths take
 /// 16 MiB at a time, in 4 KiB pages, and the heap is not trimmed below 512 MiB, so that the advised
 /// range stays. glibc does the same under GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which a program cannot
-/// set for itself. The heap's head below its first 2 MiB boundary is held unused: arrays placed there
-/// faulted in 4 KiB pages, 100 to 500 of them by where the heap happened to start. The time before the
-/// first step, interleaved against 4 KiB pages (2026-11-28): on an AMD EPYC of family 26, where a fresh
-/// page costs 10–14 µs, 57 × 31 16.7 → 10.8 ms, 113 × 61 67 → 30 ms, 225 × 121 321 → 138 ms, and with the
-/// head held 57 × 31 6.9 ms, 113 × 61 25.6 ms; on one of family 25, 1.26× at 113 × 61 and 225 × 121,
-/// though one 225 × 121 start-up in three there took 200 ms longer.
+/// set for itself. The heap below its first 2 MiB boundary would be served in 4 KiB pages (100 to 500
+/// faults in a 57 × 31 start-up, by where the heap starts), so a block that is never touched holds it.
+/// The time before the first step, interleaved against 4 KiB pages (2026-11-28): on an AMD EPYC of
+/// family 26, where a fresh page costs 10–14 µs, 57 × 31 16.7 → 10.8 ms, 113 × 61 67 → 30 ms,
+/// 225 × 121 321 → 138 ms; on one of family 25, 1.26× at 113 × 61 and 225 × 121, though one 225 × 121
+/// start-up in three there took 200 ms longer. Holding the heap's head, against not holding it (family
+/// 26, the same day): 57 × 31 10.5 → 6.9 ms, 113 × 61 29.7 → 25.6 ms.
 void reuseFreedMemoryOnHugePages() {
   constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
   mallopt(M_TOP_PAD, 256 << 20);
   const auto heap_start = reinterpret_cast<std::uintptr_t>(sbrk(0));
-  void* volatile growth = std::malloc(256 << 10);             // volatile: a malloc freed unused may be left out
-  const auto top = reinterpret_cast<std::uintptr_t>(growth);  // where the heap's free space begins
+  void* volatile growth = std::malloc(256 << 10);  // volatile: a malloc freed unused may be left out
+  // The first address malloc hands out from the heap's free top.
+  const auto top = reinterpret_cast<std::uintptr_t>(growth);
   std::free(growth);
   mallopt(M_TOP_PAD, 16 << 20);
   const auto heap_end = reinterpret_cast<std::uintptr_t>(sbrk(0));
   const std::uintptr_t aligned_start = (heap_start + kHugePage - 1) & ~(kHugePage - 1);
   if (heap_end > aligned_start) {
     madvise(reinterpret_cast<void*>(aligned_start), heap_end - aligned_start, MADV_HUGEPAGE);
-    // Below the first huge page, up to 2 MiB of the heap would be served in 4 KiB pages (where it starts
-    // is random): a block held for the whole run, never touched, keeps the arrays above it.
+    // Held from the free top's start to 16 bytes below aligned_start (glibc: 16-byte chunk headers, sizes
+    // in 16s), so that the next array's data begins at aligned_start. Static: held for the whole run.
     constexpr std::uintptr_t kChunkHeader = 2 * sizeof(std::size_t);
     [[maybe_unused]] static void* volatile head = nullptr;
     if (aligned_start > top + kChunkHeader) head = std::malloc(aligned_start - top - kChunkHeader);
