@@ -12,21 +12,21 @@ source "$here/scripts/ros_env.sh"
 export ROS_IP=127.0.0.1 ROS_HOSTNAME=127.0.0.1
 results="$RIG_WS/build/test_results"
 rm -rf "$results"
-# The test programs build on both cores; the tests then run one at a time: several watch a live rig
-# against the wall clock (its pace, its services' answers), and two at once share the machine's cores.
-catkin_make -C "$RIG_WS" --source "$RIG_ROOT" tests -j2 >"$RIG_WS/build_tests.log" 2>&1 || {
-  tail -n 50 "$RIG_WS/build_tests.log"
+# A step that did not finish: the end of its log, and the one-line verdict.
+step_failed() {
+  tail -n 50 "$1"
   echo "0 passed, 1 failed"
   exit 1
 }
+# The test programs build on both cores; the tests then run one at a time: several watch a live rig
+# against the wall clock (its pace, its services' answers), and two at once share the machine's cores.
+catkin_make -C "$RIG_WS" --source "$RIG_ROOT" tests -j2 >"$RIG_WS/build_tests.log" 2>&1 ||
+  step_failed "$RIG_WS/build_tests.log"
 # catkin_make run_tests exits 0 even when tests fail: the verdict comes from catkin_test_results.
 # The rviz test draws: the tests run on a virtual screen (Xvfb, software GL).
 "$here/scripts/loopback_only.sh" xvfb-run -a -s "-screen 0 1400x900x24" \
-  catkin_make -C "$RIG_WS" --source "$RIG_ROOT" run_tests -j1 >"$RIG_WS/run_tests.log" 2>&1 || {
-  tail -n 50 "$RIG_WS/run_tests.log"
-  echo "0 passed, 1 failed"
-  exit 1
-}
+  catkin_make -C "$RIG_WS" --source "$RIG_ROOT" run_tests -j1 >"$RIG_WS/run_tests.log" 2>&1 ||
+  step_failed "$RIG_WS/run_tests.log"
 # catkin_test_results decides pass/fail; count_results.py counts (catkin's summary counts gtest twice).
 catkin_test_results "$results" >/dev/null 2>&1
 verdict=$?

@@ -16,7 +16,6 @@
 
 #include "friction_sim/instruments/results_io.h"
 #include "friction_sim/run/run_driver.h"
-#include "friction_sim/scene/loading_protocol.h"
 #include "test_helpers.h"
 
 namespace friction::testing {
@@ -53,31 +52,27 @@ std::string readFile(const std::string& path) {
   return text.str();
 }
 
-std::vector<std::vector<std::string>> csvCells(const std::string& text) {
-  std::vector<std::vector<std::string>> rows;
-  std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);) rows.push_back(splitCsvLine(line));
-  return rows;
-}
-
-/// The same table: each cell the same text, or a finite number within `relative` of the pinned one.
+/// The same table: the same header, and each cell the same text or a finite number within `relative` of
+/// the pinned one.
 void expectSameEventsWithin(const std::string& events, const std::string& pinned, double relative) {
-  const auto rows = csvCells(events), pinned_rows = csvCells(pinned);
-  ASSERT_EQ(rows.size(), pinned_rows.size());
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    ASSERT_EQ(rows[r].size(), pinned_rows[r].size()) << "row " << r;
-    for (std::size_t c = 0; c < rows[r].size(); ++c) {
-      const std::string& cell = rows[r][c];
-      const std::string& pinned_cell = pinned_rows[r][c];
-      // The header, text, counts, flags, nan and inf alike: the same text.
+  const CsvTable table(events), pinned_table(pinned);
+  ASSERT_EQ(table.columns, pinned_table.columns);
+  ASSERT_EQ(table.rows.size(), pinned_table.rows.size());
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    ASSERT_EQ(table.rows[r].size(), pinned_table.rows[r].size()) << "row " << r;
+    for (std::size_t c = 0; c < table.rows[r].size(); ++c) {
+      const std::string& cell = table.rows[r][c];
+      const std::string& pinned_cell = pinned_table.rows[r][c];
+      // Text, counts, flags, nan and inf alike: the same text.
       if (cell == pinned_cell) continue;
+      const std::string& column = pinned_table.columns[c];
       char* end = nullptr;
       const double value = std::strtod(cell.c_str(), &end);
-      const bool number = r > 0 && !cell.empty() && *end == '\0' && std::isfinite(value);
+      const bool number = !cell.empty() && *end == '\0' && std::isfinite(value);
       const double expected = std::strtod(pinned_cell.c_str(), &end);
       ASSERT_TRUE(number && !pinned_cell.empty() && *end == '\0' && std::isfinite(expected))
-          << "row " << r << ", " << pinned_rows[0][c] << ": " << cell << " against " << pinned_cell;
-      EXPECT_NEAR(value, expected, relative * std::abs(expected)) << "row " << r << ", " << pinned_rows[0][c];
+          << "row " << r << ", " << column << ": " << cell << " against " << pinned_cell;
+      EXPECT_NEAR(value, expected, relative * std::abs(expected)) << "row " << r << ", " << column;
     }
   }
 }

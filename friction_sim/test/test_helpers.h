@@ -7,11 +7,13 @@
 #include <cmath>
 #include <mutex>
 #include <set>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "friction_sim/model/model.h"
+#include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/scene/scene.h"
 #include "friction_sim/scene/scene_io.h"
 #include "friction_sim/solvers/integrator.h"
@@ -185,6 +187,25 @@ class RecordingHooks : public StripHooks {  // each dof's records are its own: t
     const std::lock_guard<std::mutex> lock(threads_mutex_);
     threads_.insert(std::this_thread::get_id());
   }
+};
+
+/// A CSV table: its header's column names, then one row of cells per line.
+struct CsvTable {
+  explicit CsvTable(const std::string& text) {
+    std::istringstream lines(text);
+    std::string line;
+    std::getline(lines, line);
+    columns = splitCsvLine(line);
+    while (std::getline(lines, line)) rows.push_back(splitCsvLine(line));
+  }
+  bool has(const std::string& column) const {
+    return std::find(columns.begin(), columns.end(), column) != columns.end();
+  }
+  double number(std::size_t row, const std::string& column) const {
+    return std::stod(rows[row][std::find(columns.begin(), columns.end(), column) - columns.begin()]);
+  }
+  std::vector<std::string> columns;
+  std::vector<std::vector<std::string>> rows;
 };
 
 }  // namespace friction::testing

@@ -456,25 +456,6 @@ TEST(QuasiStaticCreep, CreepingSliderHasTheFullDynamicsPrecursors) {
   EXPECT_LT(std::abs(creeping.energy().relativeResidual()), 5e-3);
 }
 
-/// A CSV table: its header's column names, then one row of cells per line.
-struct CsvTable {
-  explicit CsvTable(const std::string& text) {
-    std::istringstream lines(text);
-    std::string line;
-    std::getline(lines, line);
-    columns = splitCsvLine(line);
-    while (std::getline(lines, line)) rows.push_back(splitCsvLine(line));
-  }
-  bool has(const std::string& column) const {
-    return std::find(columns.begin(), columns.end(), column) != columns.end();
-  }
-  double number(std::size_t row, const std::string& column) const {
-    return std::stod(rows[row][std::find(columns.begin(), columns.end(), column) - columns.begin()]);
-  }
-  std::vector<std::string> columns;
-  std::vector<std::vector<std::string>> rows;
-};
-
 TEST(RateStateResults, TheFilesHoldEachContactsAgeingStrengthAndWhenEachNodeLastSlipped) {
   const Scene scene = coarseRateStateSlider(true);
   RunDriver driver(scene, requireValidScene(scene));
@@ -488,7 +469,7 @@ TEST(RateStateResults, TheFilesHoldEachContactsAgeingStrengthAndWhenEachNodeLast
 
   // At every onset no contact is older than the run plus the initial age. The leading edge is that old
   // until the precursors have loaded it enough to creep (measured: through the 11th onset).
-  const CsvTable stresses(stresses_csv.str());
+  const testing::CsvTable stresses(stresses_csv.str());
   ASSERT_TRUE(stresses.has("interface_static_coefficient"));
   const auto nodes_x = static_cast<std::size_t>(scene.lattice.nodes_x);
   int onsets = 0;
@@ -510,7 +491,7 @@ TEST(RateStateResults, TheFilesHoldEachContactsAgeingStrengthAndWhenEachNodeLast
 
   // Every node that slipped in an event did so from its first unsticking to its last slip, and the last
   // of them stopped within a step of the event's end.
-  const CsvTable nodes(event_nodes_csv.str());
+  const testing::CsvTable nodes(event_nodes_csv.str());
   ASSERT_TRUE(nodes.has("last_slip_time_s"));
   std::vector<double> latest(events.size(), -std::numeric_limits<double>::infinity());
   for (std::size_t row = 0; row < nodes.rows.size(); ++row) {

@@ -32,20 +32,16 @@ constexpr int kOutputUnwritable = 4;
 
 /// Lets a run reuse the memory it frees, on transparent huge pages. A run allocates and frees arrays of
 /// 0.1 to 30 MB: the stiffness matrix, the factor's analysis and panels, the solves' vectors. glibc maps
-/// each one above 128 KiB afresh until its threshold adapts, and every fresh page is a fault (about 1040
-/// in a 57 × 31 start-up). Served from the heap, they reuse pages already touched; arrays above 32 MiB
-/// (glibc's largest threshold) are still mapped apart. The heap's first growth reserves 256 MiB of
+/// each one above 128 KiB afresh until its threshold adapts, and every fresh page is a fault, which costs
+/// 10–14 µs on some virtual machines. Served from the heap, they reuse pages already touched; arrays above
+/// 32 MiB (glibc's largest threshold) are still mapped apart. The heap's first growth reserves 256 MiB of
 /// addresses (pages are taken only when touched), advised for huge pages where the kernel allows them
 /// (its `madvise` mode, Debian's and Ubuntu's default): a fault then brings 2 MiB. Later growths take
 /// 16 MiB at a time, in 4 KiB pages, and the heap is not trimmed below 512 MiB, so that the advised
 /// range stays. glibc does the same under GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which a program cannot
 /// set for itself. The heap below its first 2 MiB boundary would be served in 4 KiB pages (100 to 500
 /// faults in a 57 × 31 start-up, by where the heap starts), so a block that is never touched holds it.
-/// The time before the first step, interleaved against 4 KiB pages (2026-11-28): on an AMD EPYC of
-/// family 26, where a fresh page costs 10–14 µs, 57 × 31 16.7 → 10.8 ms, 113 × 61 67 → 30 ms,
-/// 225 × 121 321 → 138 ms; on one of family 25, 1.26× at 113 × 61 and 225 × 121, though one 225 × 121
-/// start-up in three there took 200 ms longer. Holding the heap's head, against not holding it (family
-/// 26, the same day): 57 × 31 10.5 → 6.9 ms, 113 × 61 29.7 → 25.6 ms.
+/// What each part saves: CHANGELOG.md (2026-11-28).
 void reuseFreedMemoryOnHugePages() {
   constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
