@@ -13,6 +13,7 @@ import statistics
 import subprocess
 import tempfile
 import threading
+import time
 import unittest
 
 import rosunit
@@ -111,6 +112,41 @@ def listening(net_directory):
         with open(os.path.join(net_directory, table)) as handle:
             found += [row.split()[1] for row in list(handle)[1:] if row.split()[3] == "0A"]
     return found
+
+
+def received_unread(pid):
+    """Bytes that have reached the TCP sockets of process `pid` and that it has not read yet."""
+    inodes = set()
+    for fd in os.listdir("/proc/%d/fd" % pid):
+        try:
+            target = os.readlink("/proc/%d/fd/%s" % (pid, fd))
+        except OSError:
+            continue
+        socket = re.fullmatch(r"socket:\[(\d+)\]", target)
+        if socket:
+            inodes.add(socket.group(1))
+    unread = 0
+    for table in ("tcp", "tcp6"):
+        with open("/proc/%d/net/%s" % (pid, table)) as handle:
+            for row in list(handle)[1:]:
+                fields = row.split()  # ... tx_queue:rx_queue (hex) at 4, the socket's inode at 9
+                if fields[9] in inodes:
+                    unread += int(fields[4].split(":")[1], 16)
+    return unread
+
+
+def settled(read, quiet=0.5, timeout=120):
+    """read()'s value once it is above zero and has not changed for `quiet` s (0 if it never is)."""
+    last, still_since = read(), time.monotonic()
+    deadline = still_since + timeout
+    while time.monotonic() < deadline:
+        time.sleep(0.05)
+        value = read()
+        if value != last:
+            last, still_since = value, time.monotonic()
+        elif value > 0 and time.monotonic() - still_since >= quiet:
+            return value
+    return 0
 
 
 def launch(*args, cwd=None, env=None, launch_file=(RIG,)):
@@ -362,9 +398,10 @@ class RigLaunchStatusTest(unittest.TestCase):
             flood.stdin.write("go\n")
             flood.stdin.flush()
             self.assertEqual(flood.stdout.readline().strip(), "sent")
-            # "sent" means queued in rospy; its writer thread fills the socket while the simulator is
-            # stopped, and on a host busy with other tests one second was not always enough (0 dropped).
-            threading.Event().wait(3.0)
+            # "sent" means queued in rospy; its writer thread fills the stopped simulator's socket. Once
+            # nothing more arrives there, all that fits has come: resumed, its network thread reads it
+            # faster than the queue is served.
+            self.assertGreater(settled(lambda: received_unread(run.simulator)), 0)
             os.kill(run.simulator, signal.SIGCONT)
             flood.communicate(timeout=60)
             state = subprocess.run(client(run.lines, ["rostopic", "echo", "-n", "1",
