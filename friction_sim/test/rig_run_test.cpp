@@ -31,7 +31,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -47,9 +46,12 @@
 #include "friction_sim/run/simulation.h"
 #include "friction_sim/scene/loading_protocol.h"
 #include "friction_sim/scene/scene_io.h"
+#include "text_file.h"
 
 namespace friction {
 namespace {
+
+using testing::readFile;
 
 /// What a run showed on its topics.
 struct Observed {
@@ -122,14 +124,6 @@ class BackgroundCommand {
 /// A path in /tmp named after this test node (`what` appended): full_run and full_run_rate_state run at
 /// the same time under `run_tests -j2`.
 std::string ownTemporaryPath(const std::string& what) { return "/tmp/" + ros::this_node::getName().substr(1) + what; }
-
-/// The whole text of a file ("" if it cannot be read).
-std::string readFile(const std::string& path) {
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
 
 bool waitFor(const std::function<bool()>& condition, double seconds) {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);

@@ -17,6 +17,7 @@
 #include "friction_sim/instruments/results_io.h"
 #include "friction_sim/run/run_driver.h"
 #include "test_helpers.h"
+#include "text_file.h"
 
 namespace friction::testing {
 namespace {
@@ -44,13 +45,6 @@ constexpr bool kPinsBuild = false;
 constexpr double kOtherBuildTolerance = 1e-6;
 
 std::string pinnedEventsPath(const std::string& scene) { return std::string(PINNED_DIR) + "/" + scene + ".events.csv"; }
-
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 /// The same table: the same header, and each cell the same text or a finite number within `relative` of
 /// the pinned one.
