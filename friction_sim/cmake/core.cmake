@@ -26,6 +26,7 @@ add_library(friction_sim_core_objects OBJECT
   src/core/model/model.cpp
   src/core/run/command_schedule.cpp
   src/core/run/fast_forward.cpp
+  src/core/run/process_memory.cpp
   src/core/run/quasi_static_creep.cpp
   src/core/run/run_driver.cpp
   src/core/run/simulation.cpp

@@ -3,9 +3,11 @@
 #include <iostream>
 
 #include "friction_sim/ros/rig_simulator.h"
+#include "friction_sim/run/process_memory.h"
 #include "friction_sim/scene/config_error.h"
 
 int main(int argc, char** argv) {
+  friction::reuseFreedMemoryOnHugePages();
   ros::init(argc, argv, "rig_simulator", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, [](int) { friction::g_stop_requested = true; });
   std::signal(SIGTERM, [](int) { friction::g_stop_requested = true; });

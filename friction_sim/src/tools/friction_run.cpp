@@ -1,12 +1,9 @@
 // friction_run: runs a scene offline (no ROS master) to its stop condition and writes the results.
 // `friction_run --help` lists its arguments and the files it writes (help() below).
-#include <malloc.h>
-#include <sys/mman.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -15,6 +12,7 @@
 #include <stdexcept>
 
 #include "friction_sim/instruments/results_io.h"
+#include "friction_sim/run/process_memory.h"
 #include "friction_sim/run/run_driver.h"
 #include "friction_sim/scene/scene_io.h"
 
@@ -29,41 +27,6 @@ constexpr const char* kUsage =
 constexpr int kBadCommandLine = 2;
 constexpr int kSceneRefused = 3;
 constexpr int kOutputUnwritable = 4;
-
-/// Lets a run reuse the memory it frees, on transparent huge pages. A run allocates and frees arrays of
-/// 0.1 to 30 MB: the stiffness matrix, the factor's analysis and panels, the solves' vectors. glibc maps
-/// each one above 128 KiB afresh until its threshold adapts, and every fresh page is a fault, which costs
-/// 10–14 µs on some virtual machines. Served from the heap, they reuse pages already touched; arrays above
-/// 32 MiB (glibc's largest threshold) are still mapped apart. The heap's first growth reserves 256 MiB of
-/// addresses (pages are taken only when touched), advised for huge pages where the kernel allows them
-/// (its `madvise` mode, Debian's and Ubuntu's default): a fault then brings 2 MiB. Later growths take
-/// 16 MiB at a time, in 4 KiB pages, and the heap is not trimmed below 512 MiB, so that the advised
-/// range stays. glibc does the same under GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which a program cannot
-/// set for itself. The heap below its first 2 MiB boundary would be served in 4 KiB pages (100 to 500
-/// faults in a 57 × 31 start-up, by where the heap starts), so a block that is never touched holds it.
-/// What each part saves: CHANGELOG.md (2026-11-28).
-void reuseFreedMemoryOnHugePages() {
-  constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TRIM_THRESHOLD, 512 << 20);
-  mallopt(M_TOP_PAD, 256 << 20);
-  const auto heap_start = reinterpret_cast<std::uintptr_t>(sbrk(0));
-  void* volatile growth = std::malloc(256 << 10);  // volatile: a malloc freed unused may be left out
-  // The first address malloc hands out from the heap's free top.
-  const auto top = reinterpret_cast<std::uintptr_t>(growth);
-  std::free(growth);
-  mallopt(M_TOP_PAD, 16 << 20);
-  const auto heap_end = reinterpret_cast<std::uintptr_t>(sbrk(0));
-  const std::uintptr_t aligned_start = (heap_start + kHugePage - 1) & ~(kHugePage - 1);
-  if (heap_end > aligned_start) {
-    madvise(reinterpret_cast<void*>(aligned_start), heap_end - aligned_start, MADV_HUGEPAGE);
-    // Held from the free top's start to 16 bytes below aligned_start (glibc: 16-byte chunk headers, sizes
-    // in 16s), so that the next array's data begins at aligned_start. Static: held for the whole run.
-    constexpr std::uintptr_t kChunkHeader = 2 * sizeof(std::size_t);
-    [[maybe_unused]] static void* volatile head = nullptr;
-    if (aligned_start > top + kChunkHeader) head = std::malloc(aligned_start - top - kChunkHeader);
-  }
-}
 
 int refuseOutput(const std::string& out_dir, const std::string& reason) {
   std::cerr << "friction_run: --out " << out_dir << ": " << reason << "\n";
@@ -262,7 +225,7 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  reuseFreedMemoryOnHugePages();
+  friction::reuseFreedMemoryOnHugePages();
   try {
     return run(argc, argv);
   } catch (const friction::ConfigError& error) {
