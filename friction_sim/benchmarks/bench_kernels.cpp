@@ -18,12 +18,12 @@
 #include <vector>
 
 #include "friction_sim/model/lattice_2d.h"
-#include "friction_sim/run/process_memory.h"
 #include "friction_sim/run/simulation.h"
 #include "friction_sim/scene/scene_io.h"
 #include "friction_sim/solvers/integrator.h"
 #include "friction_sim/solvers/static_solver.h"
 #include "naive_lattice.h"
+#include "process_memory.h"
 
 namespace friction {
 namespace {
@@ -289,12 +289,10 @@ BENCHMARK(staticSolveColumns)->Args({57, 31})->Args({225, 121})->Unit(benchmark:
 }  // namespace friction
 
 int main(int argc, char** argv) {
-  // The runs' own heap: without it the static benchmarks time page faults (staticFactor/225/121 read
-  // 280 ms against 108 ms with it, 2026-11-28, on a host where a fresh page costs 10–14 µs).
+  // The heap a run has, so that the static benchmarks time the work and not first-touch page faults.
   friction::reuseFreedMemoryOnHugePages();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
   return 0;
 }

@@ -26,7 +26,6 @@ add_library(friction_sim_core_objects OBJECT
   src/core/model/model.cpp
   src/core/run/command_schedule.cpp
   src/core/run/fast_forward.cpp
-  src/core/run/process_memory.cpp
   src/core/run/quasi_static_creep.cpp
   src/core/run/run_driver.cpp
   src/core/run/simulation.cpp
@@ -95,7 +94,11 @@ target_link_options(friction_sim_core PRIVATE -Wl,-Bsymbolic-functions)
 # with the core, libstdc++, libgcc, libgomp, yaml-cpp and AMD linked in (an empty C program 0.7 ms;
 # 2026-11-28, AMD EPYC family 25). Only the C library and libm stay shared. Where a static archive is
 # missing, or under the sanitizers (whose runtimes want the shared C++ library), it links as the nodes do.
+# How the processes that run simulations take their memory (glibc's settings): theirs, not the core's.
+add_library(friction_sim_process_memory OBJECT src/tools/process_memory.cpp)
+target_include_directories(friction_sim_process_memory PUBLIC src/tools)
 add_executable(friction_run src/tools/friction_run.cpp)
+target_link_libraries(friction_run friction_sim_process_memory)
 find_library(YAML_CPP_ARCHIVE libyaml-cpp.a)
 find_library(AMD_ARCHIVE libamd.a)
 find_library(SUITESPARSECONFIG_ARCHIVE libsuitesparseconfig.a)

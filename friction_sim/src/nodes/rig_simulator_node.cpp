@@ -3,10 +3,11 @@
 #include <iostream>
 
 #include "friction_sim/ros/rig_simulator.h"
-#include "friction_sim/run/process_memory.h"
 #include "friction_sim/scene/config_error.h"
+#include "process_memory.h"
 
 int main(int argc, char** argv) {
+  // Its start-up builds and factors the slider as friction_run's does, with the same many large arrays.
   friction::reuseFreedMemoryOnHugePages();
   ros::init(argc, argv, "rig_simulator", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, [](int) { friction::g_stop_requested = true; });

@@ -5,16 +5,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <optional>
 #include <stdexcept>
 
 #include "friction_sim/instruments/results_io.h"
-#include "friction_sim/run/process_memory.h"
 #include "friction_sim/run/run_driver.h"
 #include "friction_sim/scene/scene_io.h"
+#include "process_memory.h"
 
 namespace {
 
