@@ -104,14 +104,17 @@ def client(lines, command):
     return (entry.group(1).split() if entry else []) + command
 
 
-def listening(net_directory):
-    """The local address (hex, as the kernel writes it) of every listening TCP socket of a network namespace,
-    from its /proc/<pid>/net."""
-    found = []
+def tcp_sockets(net_directory):
+    """The fields of every TCP socket of a network namespace, from its /proc/<pid>/net: the local address
+    (hex, as the kernel writes it) at 1, the state at 3, tx_queue:rx_queue (hex) at 4, the inode at 9."""
     for table in ("tcp", "tcp6"):
         with open(os.path.join(net_directory, table)) as handle:
-            found += [row.split()[1] for row in list(handle)[1:] if row.split()[3] == "0A"]
-    return found
+            yield from (row.split() for row in list(handle)[1:])
+
+
+def listening(net_directory):
+    """The local address of every listening TCP socket of a network namespace (tcp_sockets)."""
+    return [fields[1] for fields in tcp_sockets(net_directory) if fields[3] == "0A"]
 
 
 def received_unread(pid):
@@ -125,14 +128,8 @@ def received_unread(pid):
         socket = re.fullmatch(r"socket:\[(\d+)\]", target)
         if socket:
             inodes.add(socket.group(1))
-    unread = 0
-    for table in ("tcp", "tcp6"):
-        with open("/proc/%d/net/%s" % (pid, table)) as handle:
-            for row in list(handle)[1:]:
-                fields = row.split()  # ... tx_queue:rx_queue (hex) at 4, the socket's inode at 9
-                if fields[9] in inodes:
-                    unread += int(fields[4].split(":")[1], 16)
-    return unread
+    return sum(int(fields[4].split(":")[1], 16) for fields in tcp_sockets("/proc/%d/net" % pid)
+               if fields[9] in inodes)
 
 
 def settled(read, quiet=0.5, timeout=120):
