@@ -111,8 +111,10 @@ if(YAML_CPP_ARCHIVE AND AMD_ARCHIVE AND SUITESPARSECONFIG_ARCHIVE AND IS_ABSOLUT
   target_sources(friction_run PRIVATE $<TARGET_OBJECTS:friction_sim_core_objects>)
   target_link_libraries(friction_run friction_sim_core_interface ${YAML_CPP_ARCHIVE} ${AMD_ARCHIVE}
     ${SUITESPARSECONFIG_ARCHIVE} ${GOMP_ARCHIVE} Threads::Threads ${CMAKE_DL_LIBS} -static-libstdc++ -static-libgcc)
+  set(FRICTION_RUN_LINKAGE static)
 else()
   target_link_libraries(friction_run friction_sim_core)
+  set(FRICTION_RUN_LINKAGE shared)
 endif()
 
 # The core's unit tests (GoogleTest), run by catkin or by CTest.
