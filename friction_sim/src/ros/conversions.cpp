@@ -179,7 +179,7 @@ TimedCommand fromMsg(const friction_msgs::StageCommand& msg) {
     case friction_msgs::StageCommand::POSITION:
       command.stage = {StageMode::Position, msg.speed, msg.target};
       break;
-    default:
+    default:  // HOLD; an unknown mode is refused before (checkMode)
       // A hold has no speed or target: the message's fields are left over from the sender, not asked for.
       command.stage = {StageMode::Hold, 0.0, 0.0};
       break;
@@ -197,18 +197,25 @@ friction_msgs::StageCommand toMsg(const TimedCommand& command) {
   }
   msg.speed = command.stage.speed;
   msg.target = command.stage.target;
-  switch (command.stage.mode) {
+  msg.mode = toMsgMode(command.stage.mode);
+  return msg;
+}
+
+std::uint8_t toMsgMode(StageMode mode) {
+  using Command = friction_msgs::StageCommand;
+  using State = friction_msgs::StageState;
+  static_assert(int{State::VELOCITY} == int{Command::VELOCITY} && int{State::HOLD} == int{Command::HOLD} &&
+                    int{State::POSITION} == int{Command::POSITION},
+                "StageState and StageCommand number the stage's modes alike");
+  switch (mode) {
     case StageMode::Velocity:
-      msg.mode = friction_msgs::StageCommand::VELOCITY;
-      break;
+      return friction_msgs::StageCommand::VELOCITY;
     case StageMode::Position:
-      msg.mode = friction_msgs::StageCommand::POSITION;
-      break;
+      return friction_msgs::StageCommand::POSITION;
     case StageMode::Hold:
-      msg.mode = friction_msgs::StageCommand::HOLD;
       break;
   }
-  return msg;
+  return friction_msgs::StageCommand::HOLD;
 }
 
 }  // namespace friction

@@ -6,6 +6,8 @@
 #include <optional>
 #include <sstream>
 
+#include <ros/this_node.h>
+
 #include "friction_sim/scene/config_error.h"
 
 namespace friction {
@@ -79,7 +81,11 @@ std::string ParameterReader::wrongType(const std::string& name, const char* allo
 void ParameterReader::refuseIfAny(const std::vector<std::string>& checks) const {
   std::vector<std::string> problems = problems_;
   problems.insert(problems.end(), checks.begin(), checks.end());
-  if (!problems.empty()) throw ConfigError("parameters of " + nh_.getNamespace(), problems);
+  refuseParameters(problems);
+}
+
+void refuseParameters(const std::vector<std::string>& problems) {
+  if (!problems.empty()) throw ConfigError("parameters of " + ros::this_node::getName(), problems);
 }
 
 }  // namespace friction

@@ -9,8 +9,9 @@ namespace friction {
 
 std::vector<std::string> validateDetectorOptions(const DetectorOptions& options) {
   std::vector<std::string> problems;
-  requireSetting(options.front_fit_nodes >= 2 || options.front_fit_nodes == 0, "~front_fit_nodes",
-                 options.front_fit_nodes, ">= 2, or 0 for the scene's", problems);
+  requireSetting(options.front_fit_nodes >= InstrumentSpec::kFewestFrontFitNodes || options.front_fit_nodes == 0,
+                 "~front_fit_nodes", options.front_fit_nodes,
+                 ">= " + std::to_string(InstrumentSpec::kFewestFrontFitNodes) + ", or 0 for the scene's", problems);
   if (options.scene_path.empty() && !options.overrides.empty()) {
     problems.push_back("~overrides: '" + options.overrides + "' given without ~scene; allowed: overrides of a scene");
   }
@@ -42,8 +43,10 @@ DetectorSettings detectorSettings(const Scene* scene, int front_fit_nodes) {
 
 DetectorSettings resolveDetectorSettings(const DetectorOptions& options) {
   if (options.scene_path.empty()) return detectorSettings(nullptr, options.front_fit_nodes);
-  std::vector<std::string> ignored;  // validateDetectorOptions has refused malformed overrides
-  const Scene scene = loadScene(options.scene_path, parseOverrides(options.overrides, ignored));
+  std::vector<std::string> problems;
+  const auto overrides = parseOverrides(options.overrides, problems);
+  refuseParameters(problems);
+  const Scene scene = loadScene(options.scene_path, overrides);
   return detectorSettings(&scene, options.front_fit_nodes);
 }
 
@@ -125,10 +128,10 @@ void PrecursorDetector::publishCompleted(bool no_more_readings) {
   for (const SlipEvent& event : detector_->takeCompletedEvents(no_more_readings)) {
     const double length = detector_->sliderLength();
     events_pub_.publish(toMsg(event, positions_, length, settings_.wave_speeds, frame_id_));
-    points_pub_.publish(toPointMsg(event, length, frame_id_));
-    ROS_INFO_STREAM("precursor detector: event "
-                    << event.index << " F_X/F_Z = " << event.onset_shear_force / event.onset_normal_force
-                    << ", L_p/L = " << event.rupture_length / length << (event.global ? " (global)" : ""));
+    const friction_msgs::PrecursorPoint point = toPointMsg(event, length, frame_id_);
+    points_pub_.publish(point);
+    ROS_INFO_STREAM("precursor detector: event " << event.index << " F_X/F_Z = " << point.shear_ratio << ", L_p/L = "
+                                                 << point.length_ratio << (event.global ? " (global)" : ""));
   }
 }
 

@@ -32,11 +32,15 @@ namespace {
 constexpr std::uint32_t kCommandQueue = 1000;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
+/// ~bag_compression's names and the compressions they stand for.
+const std::vector<std::pair<std::string, rosbag::compression::CompressionType>> kBagCompressions = {
+    {"lz4", rosbag::compression::LZ4}, {"bz2", rosbag::compression::BZ2}, {"none", rosbag::compression::Uncompressed}};
+
 /// The compression named by ~bag_compression, or none if the name is unknown.
 std::optional<rosbag::compression::CompressionType> bagCompression(const std::string& name) {
-  if (name == "lz4") return rosbag::compression::LZ4;
-  if (name == "bz2") return rosbag::compression::BZ2;
-  if (name == "none") return rosbag::compression::Uncompressed;
+  for (const auto& [known, compression] : kBagCompressions) {
+    if (known == name) return compression;
+  }
   return std::nullopt;
 }
 }  // namespace
@@ -131,7 +135,9 @@ std::vector<std::string> validateOptions(const SimulatorOptions& o) {
   }
   if (o.frame_id.empty()) problems.push_back("~frame_id: empty; allowed: a frame name such as 'slider'");
   if (!bagCompression(o.bag_compression)) {
-    problems.push_back("~bag_compression: value '" + o.bag_compression + "' is not allowed; allowed: lz4, bz2, none");
+    std::string allowed;
+    for (const auto& [name, compression] : kBagCompressions) allowed += (allowed.empty() ? "" : ", ") + name;
+    problems.push_back("~bag_compression: value '" + o.bag_compression + "' is not allowed; allowed: " + allowed);
   }
   parseOverrides(o.overrides, problems);
   parseAwaitedSubscribers(o.wait_for_subscribers, problems);
@@ -159,11 +165,16 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   return o;
 }
 
-std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulation& simulation) {
+std::string checkMode(const friction_msgs::StageCommand& msg) {
   if (msg.mode > friction_msgs::StageCommand::NORMAL_LOAD) {
     return "mode " + std::to_string(msg.mode) + " is unknown; allowed: 0 VELOCITY, 1 HOLD, 2 POSITION, 3 NORMAL_LOAD";
   }
-  return simulation.checkCommand(fromMsg(msg));
+  return {};
+}
+
+std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulation& simulation) {
+  const std::string reason = checkMode(msg);
+  return reason.empty() ? simulation.checkCommand(fromMsg(msg)) : reason;
 }
 
 RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
@@ -171,6 +182,7 @@ RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
   std::vector<std::string> problems;
   const auto overrides = parseOverrides(options_.overrides, problems);
   awaited_subscribers_ = parseAwaitedSubscribers(options_.wait_for_subscribers, problems);
+  refuseParameters(problems);
   scene_ = loadScene(options_.scene_path, overrides, &stability_limit_);
   for (const std::string& warning : sceneWarnings(scene_)) ROS_WARN_STREAM("scene: " << warning);
   wave_speeds_ = waveSpeeds(scene_);
@@ -190,7 +202,7 @@ void RigSimulator::openBag() {
   auto refuse = [&](const std::string& why) {
     if (bag_lock_ >= 0) ::close(bag_lock_);
     bag_lock_ = -1;
-    throw ConfigError("parameters of " + ros::this_node::getName(), {"~bag: value '" + options_.bag_path + "' " + why});
+    refuseParameters({"~bag: value '" + options_.bag_path + "' " + why});
   };
   bag_lock_ = ::open(active.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (bag_lock_ < 0) {
@@ -297,7 +309,7 @@ void RigSimulator::applyLiveSettings(const SimulatorOptions& live) {
     pace_origin_sim_ = options_.real_time_factor > 0.0 ? pacedTime() : simulation().time();
     pace_origin_wall_ = ros::WallTime::now();
     driver_->setCutJumpsAtFrames(live.real_time_factor > 0.0);
-    if (live.real_time_factor <= 0.0) releasePaced(std::numeric_limits<double>::infinity());
+    if (live.real_time_factor <= 0.0) releasePaced(kInfinity);
   }
   next_snapshot_ = std::min(next_snapshot_, ros::WallTime::now() + ros::WallDuration(1.0 / live.snapshot_rate));
   options_ = live;
@@ -381,7 +393,7 @@ void RigSimulator::publishStageState(const StageStateReading& reading) {
   friction_msgs::StageState msg;
   msg.header.stamp = toStamp(cells.time);
   msg.header.frame_id = options_.frame_id;
-  msg.mode = static_cast<std::uint8_t>(stage.mode);
+  msg.mode = toMsgMode(stage.mode);
   msg.position = cells.stage_position;
   msg.velocity = stage.velocity;
   msg.target = stage.target;
@@ -396,8 +408,9 @@ void RigSimulator::publishStageState(const StageStateReading& reading) {
 }
 
 void RigSimulator::publishLiveSnapshot() {
-  // Live viewers also get snapshots at a visual rate; the bag keeps the simulated-time grid.
-  if (lattice_stream_->sampledLast() || ros::WallTime::now() < next_snapshot_ ||
+  // Live viewers also get snapshots at a visual rate, also while paused (one who joins then sees the
+  // slider); the bag keeps the simulated-time grid, and a step it sampled needs no other.
+  if ((!paused_ && lattice_stream_->sampledLast()) || ros::WallTime::now() < next_snapshot_ ||
       lattice_pub_.getNumSubscribers() == 0) {
     return;
   }
@@ -406,13 +419,14 @@ void RigSimulator::publishLiveSnapshot() {
 }
 
 std::string RigSimulator::accept(const friction_msgs::StageCommand& msg) {
-  std::string reason = checkCommand(msg, simulation());
-  if (reason.empty()) reason = driver_->checkCommandTime(fromMsg(msg));
+  std::string reason = checkMode(msg);
+  const TimedCommand command = fromMsg(msg);
+  if (reason.empty()) reason = driver_->checkCommand(command);
   if (!reason.empty()) {
     ROS_WARN_STREAM("stage command refused: " << reason);
     return reason;
   }
-  driver_->schedule(fromMsg(msg));
+  driver_->schedule(command);
   return {};
 }
 
@@ -616,7 +630,7 @@ std::string RigSimulator::runUntilTheEnd() {
       continue;
     }
     if (paused_) {
-      if (lattice_pub_.getNumSubscribers() > 0) lattice_pub_.publish(toMsg(simulation().snapshot(), options_.frame_id));
+      publishLiveSnapshot();
       standStill();
       continue;
     }

@@ -47,5 +47,7 @@ friction_msgs::LatticeSnapshot toMsg(const LatticeSnapshot& snapshot, const std:
 /// Commands: the message's mode picks a stage command or a normal-load change; stamp = when.
 TimedCommand fromMsg(const friction_msgs::StageCommand& msg);
 friction_msgs::StageCommand toMsg(const TimedCommand& command);
+/// The stage's mode as StageCommand and StageState number it.
+std::uint8_t toMsgMode(StageMode mode);
 
 }  // namespace friction

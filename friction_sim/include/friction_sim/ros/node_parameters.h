@@ -14,6 +14,9 @@ namespace friction {
 std::vector<std::pair<std::string, std::string>> parseOverrides(const std::string& text,
                                                                 std::vector<std::string>& problems);
 
+/// Throws ConfigError titled with this node's parameters if `problems` lists any.
+void refuseParameters(const std::vector<std::string>& problems);
+
 /// Reads a node's private parameters into its options struct. A parameter that is unset keeps its
 /// default, and each is written back: `rosparam get` then shows every parameter of a running node,
 /// defaults included. A number given as text is read as the number (roslaunch passes `rate:=1e4` as the

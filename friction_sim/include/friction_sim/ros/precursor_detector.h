@@ -55,8 +55,8 @@ std::vector<std::string> validateDetectorOptions(const DetectorOptions& options)
 DetectorOptions readDetectorOptions(const ros::NodeHandle& private_nh);
 /// What the detector takes from the run's scene.
 struct DetectorSettings {
-  WaveSpeeds wave_speeds;      ///< m/s, the model's (all 0, unknown, without a scene)
-  int front_fit_nodes = 5;     ///< the options' or the scene's
+  WaveSpeeds wave_speeds;                                  ///< m/s, the model's (all 0, unknown, without a scene)
+  int front_fit_nodes = InstrumentSpec{}.front_fit_nodes;  ///< the options' or the scene's (its default without one)
   double slider_length = 0.0;  ///< m, L of L_p/L: the scene's geometry.length; 0 without a scene
   SlipCriterion slip;          ///< the scene's (slipCriterion); any sliding node, without a scene
   /// Whether the detector measures the same with `other`.

@@ -41,7 +41,7 @@
 //   load_cells (geometry_msgs/WrenchStamped)       force on the slider: F_X in force.x, −F_Z in force.z
 //   strain_gauges (friction_msgs/StrainGaugeProfile)
 //   interface (friction_msgs/InterfaceState)       also at every step where a node unsticks or an event ends
-//   slip_events (friction_msgs/SlipEvent)          when an event ends
+//   slip_events (friction_msgs/SlipEvent, latched) when an event ends
 //   lattice (friction_msgs/LatticeSnapshot)
 //   stage_state (friction_msgs/StageState)
 //   scene (std_msgs/String, latched)               the scene as run, overrides applied, in the scene YAML
@@ -160,7 +160,9 @@ std::vector<std::pair<std::string, int>> parseAwaitedSubscribers(const std::stri
 std::vector<std::string> validateOptions(const SimulatorOptions& options);
 /// Reads the options from the private parameters; throws ConfigError listing every problem.
 SimulatorOptions readSimulatorOptions(const ros::NodeHandle& private_nh);
-/// Why a command must be refused (empty = acceptable).
+/// Why a command's mode must be refused (empty = a known mode).
+std::string checkMode(const friction_msgs::StageCommand& msg);
+/// Why a command must be refused (empty = acceptable): its mode, then what the simulation refuses.
 std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulation& simulation);
 
 /// Set by SIGINT/SIGTERM: the node finishes its bag and exits.

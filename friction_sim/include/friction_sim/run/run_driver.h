@@ -225,7 +225,10 @@ class RunDriver {
   /// Why `command` would never be applied (empty if it may be): stamped past a known end of the run, the
   /// scene's time limit where it ends the run, or the one set by setRunEnd.
   std::string checkCommandTime(const TimedCommand& command) const;
-  /// Schedules a command at its time (check it first with Simulation::checkCommand and checkCommandTime):
+  /// Why `command` must be refused (empty if it may be scheduled): Simulation::checkCommand, then
+  /// checkCommandTime.
+  std::string checkCommand(const TimedCommand& command) const;
+  /// Schedules a command at its time (check it first with checkCommand):
   /// what the simulation refuses it for when it is due is reported then.
   void schedule(const TimedCommand& command) { schedule_.add(command); }
   /// Schedules every command of a command table (rig_report's stage_commands.csv) read from `path`, each

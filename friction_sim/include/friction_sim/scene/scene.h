@@ -150,6 +150,7 @@ struct InstrumentSpec {
   double gauge_height = 0.002;          ///< m, z_g of the strain gauges above the interface
   std::vector<double> gauge_positions;  ///< m, gauge x positions; empty = every lattice column
   int front_fit_nodes = 5;              ///< nodes in the sliding linear fit of first-unstick times for v_c(x)
+  static constexpr int kFewestFrontFitNodes = 2;  ///< a line through fewer is no fit
   /// m/s, a node slips in a slip event when it slides at least this fast; 0: whenever it slides
   /// (SlipCriterion; rate_state nodes creep between events)
   double event_slip_speed = 0.0;

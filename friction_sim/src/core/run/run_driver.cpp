@@ -56,11 +56,13 @@ std::string RunDriver::checkCommandTime(const TimedCommand& command) const {
   return {};
 }
 
+std::string RunDriver::checkCommand(const TimedCommand& command) const {
+  std::string refusal = simulation_.checkCommand(command);
+  return refusal.empty() ? checkCommandTime(command) : refusal;
+}
+
 CommandCheck RunDriver::commandCheck() const {
-  return [this](const TimedCommand& command) {
-    std::string refusal = simulation_.checkCommand(command);
-    return refusal.empty() ? checkCommandTime(command) : refusal;
-  };
+  return [this](const TimedCommand& command) { return checkCommand(command); };
 }
 
 std::size_t RunDriver::scheduleCommandTable(const std::string& path) {

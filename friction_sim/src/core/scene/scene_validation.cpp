@@ -187,8 +187,8 @@ void checkInstrumentsStopAndIntegrator(Checker& check, const Scene& s) {
     check.within("instruments.gauge_positions[" + std::to_string(i) + "]", s.instruments.gauge_positions[i], 0.0,
                  s.geometry.length, "along the slider, 0..geometry.length");
   }
-  check.require(s.instruments.front_fit_nodes >= 2, "instruments.front_fit_nodes", s.instruments.front_fit_nodes,
-                "an integer >= 2");
+  check.require(s.instruments.front_fit_nodes >= InstrumentSpec::kFewestFrontFitNodes, "instruments.front_fit_nodes",
+                s.instruments.front_fit_nodes, "an integer >= " + std::to_string(InstrumentSpec::kFewestFrontFitNodes));
   check.require(std::isfinite(s.instruments.event_slip_speed) && s.instruments.event_slip_speed >= 0.0,
                 "instruments.event_slip_speed", s.instruments.event_slip_speed,
                 "a finite speed >= 0 m/s (0: any sliding)");
