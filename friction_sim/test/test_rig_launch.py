@@ -465,6 +465,27 @@ class RigLaunchStatusTest(unittest.TestCase):
                                  "~wait_for_subscribers: item 'camera' is not allowed",
                                  "rig_launch: failed: rig_simulator (exit code 2)")
 
+    def test_a_simulator_waiting_for_subscribers_stops_when_asked(self):
+        process = subprocess.Popen([RIG_LAUNCH, RIG, "scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false",
+                                    "wait_for_subscribers:=load_cells", "subscriber_timeout:=240"],
+                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.addCleanup(lambda: process.poll() is None and process.kill())
+        first_lines = [process.stdout.readline() for _ in range(3)]
+        master = master_uri(first_lines[0])
+        deadline = time.monotonic() + 120
+        while True:  # until the master is up (rosservice waits for the service, not for the master)
+            stop = subprocess.run(client(first_lines, ["rosservice", "call", "--wait", "/rig/stop"]),
+                                  capture_output=True, text=True, timeout=60, env=dict(os.environ, ROS_MASTER_URI=master))
+            if stop.returncode == 0 or time.monotonic() > deadline:
+                break
+            time.sleep(0.2)
+        # Answered at once, well before the 240 s the simulator would otherwise wait.
+        output = process.communicate(timeout=60)[0]
+        self.assertIn("stopping at t = 0", stop.stdout, stop.stderr)
+        self.assertEqual(process.returncode, 0, output)
+        self.assertIn("stopped by the stop service at t = 0 s", output)
+        self.assertNotIn("still waiting", output)
+
     def test_a_subscriber_that_comes_late_sees_the_run_from_its_first_frame(self):
         process = subprocess.Popen([RIG_LAUNCH, RIG, "scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false",
                                     "wait_for_subscribers:=interface", "subscriber_timeout:=240"],

@@ -582,7 +582,7 @@ void RigSimulator::run() {
 bool RigSimulator::waitForSubscribers() {
   if (awaited_subscribers_.empty()) return true;
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(options_.subscriber_timeout);
-  while (!g_stop_requested && ros::ok()) {
+  while (!stop_ && !g_stop_requested && ros::ok()) {
     const std::string missing = missingSubscribers();
     if (missing.empty()) return true;
     if (ros::WallTime::now() >= deadline) {

@@ -32,7 +32,8 @@
 //                                   that a recorder or an analysis node started with the rig sees the run
 //                                   from its start
 //   subscriber_timeout (double, 30) s of wall time to wait for them; then the node logs the topics still
-//                                   short of subscribers and exits with status 5, the run not started
+//                                   short of subscribers and exits with status 5, the run not started.
+//                                   stop and abort are answered while it waits
 //   threads (int, 1)                threads for the 2D lattice's force sweeps, used from 10³ nodes; the
 //                                   same results for any count
 //
