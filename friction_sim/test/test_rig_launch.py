@@ -7,6 +7,7 @@ with a node of their own) and writes no terminal codes into a pipe."""
 import json
 import os
 import re
+import resource
 import shutil
 import signal
 import statistics
@@ -485,6 +486,31 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertEqual(process.returncode, 0, output)
         self.assertIn("stopped by the stop service at t = 0 s", output)
         self.assertNotIn("still waiting", output)
+
+    def test_a_bag_that_cannot_be_written_further_ends_the_run_keeping_what_was_written(self):
+        # Past a file size limit of 1 MiB the bag's writes fail, as on a full disk.
+        work = tempfile.mkdtemp(prefix="rig_launch_test_")
+        self.addCleanup(shutil.rmtree, work)
+        bag = os.path.join(work, "run.bag")
+        limit = 1 << 20
+        done = subprocess.run([RIG_LAUNCH, RIG, "record:=true", "bag:=" + bag, "analysis:=false"],
+                              capture_output=True, text=True, timeout=240,
+                              preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit)))
+        output = done.stdout + done.stderr
+        self.assertEqual(done.returncode, 1, output)
+        self.assertIn("rig_launch: failed: rig_simulator (exit code 3)", output)
+        self.assertRegex(output, r"the bag could not be written \(.*\): the run ends at t = ")
+        self.assertNotIn("reached 4 global slip event(s)", output)
+        # Its index could not be written either: it stays under its temporary name, and rosbag reindex
+        # recovers the messages written.
+        active = bag + ".active"
+        self.assertIn("rosbag reindex " + active, output)
+        reindexed = subprocess.run(["rosbag", "reindex", "--output-dir", work, active], capture_output=True, text=True,
+                                   timeout=120)
+        self.assertEqual(reindexed.returncode, 0, reindexed.stdout + reindexed.stderr)
+        info = subprocess.run(["rosbag", "info", "--yaml", "--key", "topics", os.path.join(work, "run.bag.active")],
+                              capture_output=True, text=True, timeout=60)
+        self.assertIn("/rig/load_cells", info.stdout, info.stderr)
 
     def test_a_subscriber_that_comes_late_sees_the_run_from_its_first_frame(self):
         process = subprocess.Popen([RIG_LAUNCH, RIG, "scene:=" + SINGLE_BLOCK, "controller:=false", "analysis:=false",

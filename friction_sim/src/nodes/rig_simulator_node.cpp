@@ -12,9 +12,13 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "rig_simulator", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, [](int) { friction::g_stop_requested = true; });
   std::signal(SIGTERM, [](int) { friction::g_stop_requested = true; });
+  // Past a file size limit (ulimit -f) the bag's write then fails, and the node ends the run saying so,
+  // rather than being killed with the bag unclosed.
+  std::signal(SIGXFSZ, SIG_IGN);
   try {
     friction::RigSimulator simulator{ros::NodeHandle(), friction::readSimulatorOptions(ros::NodeHandle("~"))};
     simulator.run();
+    if (simulator.bagFailed()) return 3;
     if (simulator.aborted()) return 4;
     if (simulator.subscribersMissing()) return 5;
   } catch (const friction::ConfigError& error) {

@@ -212,22 +212,27 @@ void RigSimulator::openBag() {
   if (::flock(bag_lock_, LOCK_EX | LOCK_NB) != 0) {
     refuse("is being written by another rig (" + active + " is locked); allowed: a bag path no running rig writes");
   }
+  auto bag = std::make_unique<rosbag::Bag>();
   try {
-    bag_.open(active, rosbag::bagmode::Write);
-    bag_.setCompression(*bagCompression(options_.bag_compression));
+    bag->open(active, rosbag::bagmode::Write);
+    bag->setCompression(*bagCompression(options_.bag_compression));
   } catch (const rosbag::BagException& error) {
     refuse(std::string("cannot be written (") + error.what() + "); allowed: a file path in a writable directory");
   }
-  bag_open_ = true;
+  bag_ = std::move(bag);
 }
 
 void RigSimulator::closeBag() {
-  if (bag_open_) {
-    bag_.close();
-    bag_open_ = false;
-    const std::string active = activeBagPath();
-    if (std::rename(active.c_str(), options_.bag_path.c_str()) != 0) {
-      ROS_ERROR_STREAM("the bag stays at " << active << ": it could not be renamed (" << std::strerror(errno) << ")");
+  if (bag_) {
+    try {
+      bag_->close();
+      bag_.reset();
+      const std::string active = activeBagPath();
+      if (std::rename(active.c_str(), options_.bag_path.c_str()) != 0) {
+        ROS_ERROR_STREAM("the bag stays at " << active << ": it could not be renamed (" << std::strerror(errno) << ")");
+      }
+    } catch (const rosbag::BagException& error) {
+      abandonBag(error.what());
     }
   }
   if (bag_lock_ >= 0) {
@@ -354,7 +359,7 @@ void RigSimulator::publishScene() {
   std_msgs::String scene;
   scene.data = sceneToYaml(simulation().scene());
   scene_pub_.publish(scene);
-  if (bag_open_) {
+  if (bag_) {
     // Latched in the bag too, so that rosbag play latches it for whoever subscribes late. The first is
     // the bag's earliest message (1 ns: a bag cannot hold a zero stamp), a later one (a new run end) at
     // its time, after the first.
@@ -365,8 +370,32 @@ void RigSimulator::publishScene() {
     (*header)["callerid"] = ros::this_node::getName();
     (*header)["latching"] = "1";
     const ros::Time earliest(0, scenes_recorded_ == 0 ? 1 : 2);
-    bag_.write(scene_pub_.getTopic(), std::max(toStamp(simulation().time()), earliest), scene, header);
+    record(scene_pub_.getTopic(), std::max(toStamp(simulation().time()), earliest), scene, header);
     ++scenes_recorded_;
+  }
+}
+
+void RigSimulator::abandonBag(const std::string& why) {
+  bag_failure_ = why;
+  const std::string active = activeBagPath();
+  ROS_ERROR_STREAM("the bag stays at " << active << ", without its index: `rosbag reindex " << active
+                                       << "` recovers what was written");
+  // Left open on purpose: rosbag's destructor would close it again, throw once more and end the process.
+  static_cast<void>(bag_.release());
+}
+
+template <class Message>
+void RigSimulator::record(const std::string& topic, const ros::Time& stamp, const Message& msg,
+                          const boost::shared_ptr<ros::M_string>& header) {
+  if (!bag_) return;
+  try {
+    bag_->write(topic, stamp, msg, header);
+  } catch (const rosbag::BagException& error) {
+    // A full disk, say: a run the user asked to record would go on unrecorded, so it ends here.
+    ROS_ERROR_STREAM("the bag could not be written (" << error.what()
+                                                      << "): the run ends at t = " << simulation().time() << " s");
+    stop_ = true;
+    abandonBag(error.what());
   }
 }
 
@@ -375,8 +404,8 @@ void RigSimulator::emit(ros::Publisher& publisher, const std::string& topic, con
   publishPaced(msg.header.stamp.toSec(), [&publisher, msg] { publisher.publish(msg); });
   // Before the first step (t = 0, e.g. the stage state while waiting paused) nothing was measured, and
   // a bag cannot hold a zero stamp.
-  if (bag_open_ && !msg.header.stamp.isZero())
-    bag_.write(publisher.getTopic().empty() ? topic : publisher.getTopic(), msg.header.stamp, msg);
+  if (!msg.header.stamp.isZero())
+    record(publisher.getTopic().empty() ? topic : publisher.getTopic(), msg.header.stamp, msg);
 }
 
 void RigSimulator::publishClock(double time) {
@@ -445,7 +474,7 @@ void RigSimulator::publishAppliedCommand(const TimedCommand& command, const std:
   applied_commands_pub_.publish(applied);
   // Unlike a measurement, a command at t = 0 matters: in the bag at its earliest time after the
   // scene's (1 ns), its stamp kept.
-  if (bag_open_) bag_.write(applied_commands_pub_.getTopic(), std::max(applied.header.stamp, ros::Time(0, 2)), applied);
+  record(applied_commands_pub_.getTopic(), std::max(applied.header.stamp, ros::Time(0, 2)), applied);
 }
 
 void RigSimulator::onCommand(const ros::MessageEvent<const friction_msgs::StageCommand>& event) {
@@ -643,10 +672,11 @@ std::string RigSimulator::runUntilTheEnd() {
     pace();
   }
   std::ostringstream reason;
-  reason << (aborted_           ? "aborted by the abort service"
-             : stop_            ? "stopped by the stop service"
-             : g_stop_requested ? "interrupted by a signal"
-                                : "ROS shut down")
+  reason << (!bag_failure_.empty() ? "the bag could not be written (" + bag_failure_ + ")"
+             : aborted_            ? "aborted by the abort service"
+             : stop_               ? "stopped by the stop service"
+             : g_stop_requested    ? "interrupted by a signal"
+                                   : "ROS shut down")
          << " at t = " << simulation().time() << " s";
   return reason.str();
 }
@@ -661,9 +691,9 @@ void RigSimulator::finish(const std::string& end_reason) {
   summary.stop_reason = end_reason;
   printSummary(std::cout, summary);
   if (resets_ > 0) std::cout << "  (the run since the last of " << resets_ << " reset(s))" << std::endl;
-  if (bag_open_) {
+  if (bag_) {
     closeBag();
-    std::cout << "  bag written to " << options_.bag_path << std::endl;
+    if (bag_failure_.empty()) std::cout << "  bag written to " << options_.bag_path << std::endl;
   }
   // roscpp sends from its own thread: a node that exits at once can drop what it published last (the
   // last slip event, now that a run ends on the step of its last event).

@@ -81,12 +81,14 @@
 //   summary printed when the node ends is then the run since the last reset. Its wall time is the time
 //   spent running, not waiting paused.
 // Exit status: 0 when the run ended (its end, stop, a signal, ROS shut down), 2 when the scene or a
-// parameter is refused, 4 when the run was aborted, 5 when ~wait_for_subscribers' subscribers did not
-// come within ~subscriber_timeout.
+// parameter is refused, 3 when the bag could not be written (the run ends there, the bag keeping what
+// was written), 4 when the run was aborted, 5 when ~wait_for_subscribers' subscribers did not come
+// within ~subscriber_timeout.
 //
-// Commands with NaN/inf, a normal load <= 0 or beyond largestNormalForce (5 % of E over the slider's
-// base), a speed beyond the scene's stage.max_speed or an unknown mode are refused with a logged reason; the simulation
-// keeps running. A HOLD's speed and target are ignored: a hold has none.
+// A command that checkMode or RunDriver::checkCommand refuses (NaN/inf, a normal load out of range or
+// under a spring mattress, a speed beyond stage.max_speed, a POSITION speed <= 0, a stamp after the run's
+// known end, an unknown mode) is refused with a logged reason; the simulation keeps running. A HOLD's
+// speed and target are ignored: a hold has none.
 #pragma once
 
 #include <dynamic_reconfigure/server.h>
@@ -178,6 +180,8 @@ class RigSimulator {
   void run();
   /// The run was ended by the `abort` service.
   bool aborted() const { return aborted_; }
+  /// The bag could not be written (the run ended there) or closed.
+  bool bagFailed() const { return !bag_failure_.empty(); }
   /// The run never started: ~wait_for_subscribers' subscribers did not come in time.
   bool subscribersMissing() const { return subscribers_missing_; }
   /// The topics ~wait_for_subscribers may name, relative to the node's namespace.
@@ -204,8 +208,12 @@ class RigSimulator {
   std::string activeBagPath() const { return options_.bag_path + ".active"; }
   /// Opens ~bag as BAG.active, locked against a second writer; throws ConfigError if it cannot.
   void openBag();
-  /// Closes the bag and renames it to its own name, then drops the lock.
+  /// Closes the bag and renames it to its own name, then drops the lock; a bag whose index cannot be
+  /// written is abandoned.
   void closeBag();
+  /// After a failed write or close: the bag stays at BAG.active, unclosed and without its index, and the
+  /// failure is logged with the way to recover what was written.
+  void abandonBag(const std::string& why);
   void startSimulation();
   /// The scene as it runs now (its stop condition set_run_end's, if called) on `scene` and in the bag.
   void publishScene();
@@ -240,6 +248,11 @@ class RigSimulator {
   void setPaused(bool paused);
   /// s of wall time spent running (not paused) since the simulation last started.
   double runningWallTime() const;
+  /// Writes `msg` to the bag, if one is open; if it cannot be written, logs why, ends the run and closes it.
+  template <class Message>
+  void record(const std::string& topic, const ros::Time& stamp, const Message& msg,
+              const boost::shared_ptr<ros::M_string>& header = {});
+  /// Publishes `msg` (paced) on `publisher` and records it under its topic (`topic` before it is advertised).
   template <class Message>
   void emit(ros::Publisher& publisher, const std::string& topic, const Message& msg);
 
@@ -265,9 +278,9 @@ class RigSimulator {
   std::unique_ptr<dynamic_reconfigure::Server<SimulatorConfig>> reconfigure_;
   std::vector<double> interface_positions_;
   WaveSpeeds wave_speeds_;
-  rosbag::Bag bag_;
-  bool bag_open_ = false;
-  int bag_lock_ = -1;  ///< descriptor holding the flock on BAG.active while this rig writes the bag
+  std::unique_ptr<rosbag::Bag> bag_;  ///< the bag while the run is recorded (~bag); null otherwise
+  std::string bag_failure_;           ///< why the bag could not be written or closed; empty while it can
+  int bag_lock_ = -1;                 ///< descriptor holding the flock on BAG.active while this rig writes the bag
   bool paused_ = false;
   bool stop_ = false;
   bool aborted_ = false;
