@@ -83,14 +83,11 @@ void StageController::start(double time, double normal_force) {
   }
   if (refused > 0) {
     // The run would not be the protocol's: the simulator would go on under what it had before.
-    ROS_ERROR_STREAM("stage controller: " << refused << " command(s) of the protocol refused; aborting the run");
-    failed_ = true;
-    endSimulatorRun(nh_, "abort", ros::WallDuration(5.0));
-    ros::shutdown();
+    abortRun(std::to_string(refused) + " command(s) of the protocol refused");
     return;
   }
-  // The simulator ends the run itself at the protocol's end, on the step where it is reached; the
-  // watch in onStageState stays for a simulator without set_run_end.
+  // The simulator ends the run itself at the protocol's end, on the step where it is reached; where it
+  // refuses that end, the watch in onStageState stops it.
   friction_msgs::SetRunEnd end;
   end.request.global_events = static_cast<std::uint32_t>(protocol_.end.global_events);
   end.request.time = time + protocol_.end.time;
@@ -104,8 +101,19 @@ void StageController::start(double time, double normal_force) {
   ros::WallDuration(start_delay_).sleep();
   std_srvs::SetBool run;
   run.request.data = false;
-  pause_client_.call(run);
+  if (!pause_client_.call(run)) {
+    // Left paused, the simulator would wait for ever with the protocol scheduled.
+    abortRun("the simulator could not be unpaused (pause failed)");
+    return;
+  }
   ROS_INFO_STREAM("stage controller: protocol started at t = " << time << " s");
+}
+
+void StageController::abortRun(const std::string& why) {
+  ROS_ERROR_STREAM("stage controller: " << why << "; aborting the run");
+  failed_ = true;
+  endSimulatorRun(nh_, "abort", ros::WallDuration(5.0));
+  ros::shutdown();
 }
 
 void StageController::onStageState(const friction_msgs::StageState::ConstPtr& msg) {

@@ -14,10 +14,12 @@
 //   set_run_end (friction_msgs/SetRunEnd)           the protocol's end, so that the simulator ends the run
 //                                                   on the step where it is reached
 //   pause (std_srvs/SetBool)                        called with false once the schedule is sent, so
-//                                                   that a simulator started paused runs every command on time
-//   stop (std_srvs/Trigger)                        once an end condition of the protocol holds, if the
+//                                                   that a simulator started paused runs every command on
+//                                                   time; if the call fails, the controller aborts the run
+//   stop (std_srvs/Trigger)                         once an end condition of the protocol holds, if the
 //                                                   simulator did not take it through set_run_end
-//   abort (std_srvs/Trigger)                       when the protocol, a parameter or a command is refused:
+//   abort (std_srvs/Trigger)                        when the protocol, a parameter or a command is refused,
+//                                                   or the simulator cannot be unpaused:
 //                                                   the simulator ends its run and exits with status 4, the
 //                                                   node with status 2, the problems listed
 //
@@ -57,8 +59,8 @@ bool endSimulatorRun(ros::NodeHandle& nh, const std::string& service, ros::WallD
 class StageController {
  public:
   StageController(ros::NodeHandle nh, LoadingProtocol protocol, double start_delay);
-  /// The simulator refused a command of the protocol (or could not be reached): the node has aborted its
-  /// run and shut down.
+  /// The simulator refused a command of the protocol, could not be reached or could not be unpaused: the
+  /// node has aborted its run and shut down.
   bool failed() const { return failed_; }
 
  private:
@@ -68,6 +70,8 @@ class StageController {
   bool connectCommands(ros::Duration wait);
   /// Calls send_command, once more on a new connection if the call fails; false if both failed.
   bool sendCommand(friction_msgs::SendStageCommand& call);
+  /// Logs `why`, calls the simulator's abort and shuts the node down (failed()).
+  void abortRun(const std::string& why);
 
   ros::NodeHandle nh_;
   LoadingProtocol protocol_;
