@@ -11,6 +11,7 @@ from xml.etree import ElementTree
 import roslaunch.config
 import roslaunch.rlutil
 import rosunit
+from friction_sim.cfg import SimulatorConfig
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 LAUNCH = os.path.join(ROOT, "launch")
@@ -22,6 +23,11 @@ def load(launch_file, *args):
     # Machines are not assigned: that would resolve the compute host's address.
     return roslaunch.config.load_config_default([(os.path.join(LAUNCH, launch_file), list(args))], None,
                                                 assign_machines=False)
+
+
+def arguments(launch_file):
+    """A launch file's XML root: its <arg> declarations as written, defaults and docs unresolved."""
+    return ElementTree.parse(os.path.join(LAUNCH, launch_file)).getroot()
 
 
 def host(config, name):
@@ -95,14 +101,29 @@ class LaunchFilesTest(unittest.TestCase):
         self.assertEqual(alone.params["/rig/simulator/start_paused"].value, False)
 
     def test_multi_machine_declares_and_passes_on_every_argument_of_the_rig(self):
-        def arguments(launch_file):
-            return ElementTree.parse(os.path.join(LAUNCH, launch_file)).getroot()
-        rig = {arg.get("name") for arg in arguments("rig.launch").findall("arg")} - {"simulator_machine"}
+        rig = {arg.get("name"): arg for arg in arguments("rig.launch").findall("arg")}
+        del rig["simulator_machine"]
         multi = arguments("multi_machine.launch")
-        self.assertLessEqual(rig, {arg.get("name") for arg in multi.findall("arg")})
+        declared = {arg.get("name"): arg for arg in multi.findall("arg")}
         passed = {arg.get("name"): arg.get("value") for arg in multi.find("include").findall("arg")}
-        for name in rig:
+        for name, arg in rig.items():
+            self.assertIn(name, declared)
             self.assertEqual(passed.get(name), "$(arg %s)" % name, name)
+            # The same defaults, but for rviz, which the workstation opens by default.
+            if name != "rviz":
+                self.assertEqual(declared[name].get("default"), arg.get("default"), name)
+
+    def test_the_launch_files_state_the_simulators_own_defaults(self):
+        # An argument left '' leaves the simulator its default, which each doc names: the number must be
+        # the simulator's (cfg/Simulator.cfg, itself checked against the node's options in test_conversions).
+        for launch_file in ("rig.launch", "multi_machine.launch"):
+            stated = {}
+            for arg in arguments(launch_file).findall("arg"):
+                said = re.search(r"\((?:simulator )?default ([^)]+)\)", arg.get("doc", ""))
+                if said and arg.get("name") in SimulatorConfig.defaults:
+                    stated[arg.get("name")] = float(said.group(1))
+                    self.assertEqual(arg.get("default"), "", arg.get("name"))
+            self.assertEqual(stated, SimulatorConfig.defaults, launch_file)
 
     def test_the_simulator_waits_for_the_subscribers_it_is_given(self):
         config = load("rig.launch", "wait_for_subscribers:=load_cells interface:2", "subscriber_timeout:=5")
