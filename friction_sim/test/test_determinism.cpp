@@ -30,7 +30,7 @@ struct Pin {
 constexpr Pin kPins[] = {
     {"single_block", 0x33ff500570b44db8ULL}, {"pmma_1d_side", 0xefe502c3334be423ULL},
     {"pmma_1d_top", 0x40584551a61e4f73ULL},  {"pmma_2d", 0x1259b0dd968c1da4ULL},
-    {"rate_state", 0x3c10ba457087f355ULL},
+    {"rate_state", 0xd712dfdc1d5fdee5ULL},
 };
 
 void PrintTo(const Pin& pin, std::ostream* out) { *out << pin.scene; }

@@ -292,6 +292,17 @@ TEST(HardCases, WeakeningLengthShorterThanASpacingIsWarnedWithItsCohesiveZone) {
   EXPECT_NE(sceneWarnings(scene)[0].find("as amontons_coulomb does"), std::string::npos);
 }
 
+TEST(SceneWarnings, RateStateWithoutAnEventSlipSpeedIsWarnedThatEventsStartAtTheFirstCreep) {
+  Scene scene = loadScene(testing::scenePath("rate_state"));
+  EXPECT_TRUE(sceneWarnings(scene).empty());
+  scene.instruments.event_slip_speed = 0.0;
+  ASSERT_EQ(sceneWarnings(scene).size(), 1u);
+  EXPECT_NE(sceneWarnings(scene)[0].find("counts a slip from the slowest creep"), std::string::npos);
+  // Without rate_state nodes stick between events, and a slip speed of 0 is the default.
+  scene.friction.law = FrictionLawKind::AmontonsCoulomb;
+  EXPECT_TRUE(sceneWarnings(scene).empty());
+}
+
 TEST(SceneWarnings, APushingHeightBetweenLatticeRowsNamesTheRowPushed) {
   Scene scene;  // pmma_2d: rows 2.5 mm apart
   scene.pusher.height = 0.0062;

@@ -161,6 +161,8 @@ Scene rateStateBlock(double stiffness, double speed, double time_step, double in
   scene.integrator.fast_forward = false;  // full dynamics: a test that jumps says so
   scene.friction.rate_state.initial_age = initial_age;
   scene.stop = StopSpec{0, 1e6, std::numeric_limits<double>::infinity()};
+  // An event from the block's first slip: its onset is then the contact's static friction, µ(0, φ).
+  scene.instruments.event_slip_speed = 0.0;
   return scene;
 }
 
@@ -340,7 +342,7 @@ TEST(RateStateBlock, EnergyBudgetClosesThroughStickSlip) {
 
 TEST(RateStateBlock, TheCameraShowsTheStaticFrictionOfTheContactsAge) {
   Simulation simulation(loadScene(testing::scenePath("rate_state")));
-  runTo(simulation, 0.3);  // stuck: the first event comes at 0.67 s
+  runTo(simulation, 0.3);  // stuck: the first event comes at 0.70 s
   const InterfaceFrame frame = simulation.interfaceFrame();
   ASSERT_EQ(frame.static_coefficient.size(), 1u);
   EXPECT_DOUBLE_EQ(frame.static_coefficient[0], kPmma.staticCoefficient(100.0 + simulation.time()));
@@ -538,6 +540,7 @@ TEST(RateStateHardCases, CoarseTimeStepAndCriticalStiffnessStayBounded) {
   // Half the stability limit of the block on its spring (0.27 ms): a slip of a few steps. (Closer to the
   // limit the slip's ringing never dies down: the block slides on, bounded, and never re-sticks.)
   Scene at_limit = loadScene(testing::scenePath("rate_state"));
+  at_limit.instruments.event_slip_speed = 0.0;  // onsets at the first slip, at the static friction
   at_limit.integrator.time_step = 0.5 * sceneStabilityLimit(at_limit);
   at_limit.instruments.loading_curve_rate = 1.0 / at_limit.integrator.time_step;  // a sample a step at most
   Simulation coarse(at_limit);

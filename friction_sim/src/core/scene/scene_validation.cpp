@@ -368,6 +368,14 @@ std::vector<std::string> sceneWarnings(const Scene& s) {
         "friction.weakening_length: 0 m with friction.law slip_weakening drops the friction to mu_k "
         "at once, as amontons_coulomb does; give the slip distance xi_mu (m) over which it weakens");
   }
+  if (s.friction.law == FrictionLawKind::RateState && s.instruments.event_slip_speed == 0.0) {
+    // Its nodes creep, faster and faster, before they slip: from the first creep an event starts below
+    // its peak force (µ_k,macro can come out above µ_s,macro) and may not end while the interface creeps.
+    warnings.push_back(
+        "instruments.event_slip_speed: 0 m/s with friction.law rate_state counts a slip from the slowest "
+        "creep, so an event starts below its peak force; give the speed from which sliding is an event "
+        "(1e-3 m/s in the shipped rate_state scenes)");
+  }
   const double spacing = s.model == ModelKind::Lattice2D ? s.geometry.length / std::max(s.lattice.nodes_x - 1, 1)
                                                          : s.geometry.length / std::max(s.chain.blocks - 1, 1);
   if (s.model == ModelKind::Lattice2D && !s.pusher.hasBand()) {
