@@ -20,12 +20,13 @@ launch_statuses=(0 0)
 "$RIG_ROOT/scripts/rig_launch.sh" "$RIG_ROOT/launch/rig.launch" record:=true bag:="$out/run.bag" "$@" 2>&1 \
   | (trap '' INT; exec grep -vE '^\s*$|killing on exit|shutting down|^started roslaunch server|^process\[|^ROS_MASTER_URI=|^setting /run_id|^done$|REQUIRED process|process has finished|log file:|Initiating shutdown|^=+|SUMMARY|PARAMETERS|NODES|auto-starting|^ \* |^    ') \
   || launch_statuses=("${PIPESTATUS[@]}")
+# A run that wrote nothing leaves no folder; one that wrote part of a bag keeps it.
 case "${launch_statuses[0]}" in
   0) ;;
-  130) echo "run_experiment: interrupted; no figures written" >&2; exit 130 ;;
-  *) echo "run_experiment: the rig failed (its reasons are above); no figures written" >&2; exit 1 ;;
+  130) rmdir "$out" 2>/dev/null || true; echo "run_experiment: interrupted; no figures written" >&2; exit 130 ;;
+  *) rmdir "$out" 2>/dev/null || true; echo "run_experiment: the rig failed (its reasons are above); no figures written" >&2; exit 1 ;;
 esac
-[ -f "$out/run.bag" ] || { echo "run_experiment: no bag was written" >&2; exit 1; }
+[ -f "$out/run.bag" ] || { rmdir "$out" 2>/dev/null || true; echo "run_experiment: no bag was written" >&2; exit 1; }
 set +u; source "$RIG_WS/devel/setup.bash"; set -u
 /usr/bin/python3 "$RIG_ROOT/friction_sim/scripts/rig_report" "$out/run.bag" --out "$out"
 ln -sfn "$(basename "$out")" "$runs/latest"
