@@ -163,11 +163,13 @@ void checkPusher(Checker& check, const Scene& s) {
 
 void checkStage(Checker& check, const Scene& s) {
   check.positive("stage.max_speed", s.stage.max_speed);
+  std::ostringstream fastest;
+  fastest << "|speed| <= stage.max_speed (" << s.stage.max_speed << " m/s)";
   for (std::size_t i = 0; i < s.stage.program.size(); ++i) {
     const StageSegment& segment = s.stage.program[i];
     const std::string where = "stage.program[" + std::to_string(i) + "]";
     check.require(std::isfinite(segment.speed) && std::abs(segment.speed) <= s.stage.max_speed, where + ".speed",
-                  segment.speed, "|speed| <= stage.max_speed");
+                  segment.speed, fastest.str());
     if (i + 1 < s.stage.program.size()) {
       check.require(segment.duration > 0.0 && std::isfinite(segment.duration), where + ".duration", segment.duration,
                     "a finite duration > 0 s: later segments would never run");
