@@ -27,7 +27,8 @@ LoadCellReading fromMsg(const geometry_msgs::WrenchStamped& msg) {
   LoadCellReading reading;
   reading.time = msg.header.stamp.toSec();
   reading.shear_force = msg.wrench.force.x;
-  // F_Z presses down (force.z < 0); bags recorded before 2026-11-25 hold +F_Z, read the same.
+  // F_Z presses down: force.z is -F_Z. Its magnitude is read, so that bags of the rig's first sign
+  // convention (+F_Z in force.z) read alike.
   reading.normal_force = std::abs(msg.wrench.force.z);
   return reading;
 }

@@ -511,8 +511,8 @@ bool RigSimulator::onPause(std_srvs::SetBool::Request& request, std_srvs::SetBoo
 void RigSimulator::setPaused(bool paused) {
   const ros::WallTime now = ros::WallTime::now();
   if (paused && !paused_) running_wall_time_ += (now - running_since_).toSec();
-  // Only on resuming: asked to run while running, the pace keeps its origin (moving it to the
-  // simulation's time, which runs ahead of the wall clock, skipped the messages held for it).
+  // Only on resuming: asked to run while running, the pace keeps its origin. Moved to the simulation's
+  // time, which runs ahead of the wall clock, it would skip the messages held for their times.
   if (!paused && paused_) {
     running_since_ = now;
     pace_origin_wall_ = now;
@@ -696,7 +696,7 @@ void RigSimulator::finish(const std::string& end_reason) {
     if (bag_failure_.empty()) std::cout << "  bag written to " << options_.bag_path << std::endl;
   }
   // roscpp sends from its own thread: a node that exits at once can drop what it published last (the
-  // last slip event, now that a run ends on the step of its last event).
+  // last slip event: a run ends on the step of its last event).
   if (ros::ok()) ros::WallDuration(0.5).sleep();
 }
 
