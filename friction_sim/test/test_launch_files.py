@@ -2,7 +2,8 @@
 """The launch files as roslaunch reads them, without starting anything: rviz follows the rig's namespace
 (rig.rviz names /rig's topics and services, remapped to the rig's), and multi_machine.launch runs the
 simulator on the compute host and everything else, rviz included, on the workstation, with every
-argument of rig.launch passed on."""
+argument of rig.launch passed on; and every default of the simulator's live settings that the launch
+files, its header and ros_api.md state is its own."""
 import os
 import re
 import unittest
@@ -112,6 +113,17 @@ class LaunchFilesTest(unittest.TestCase):
             # The same defaults, but for rviz, which the workstation opens by default.
             if name != "rviz":
                 self.assertEqual(declared[name].get("default"), arg.get("default"), name)
+
+    def test_the_simulators_header_and_ros_api_state_its_own_defaults(self):
+        # The header's parameter block and ros_api.md's table repeat the defaults for the reader: each
+        # must be the simulator's (cfg/Simulator.cfg, checked against the node's options in test_conversions).
+        def stated(path, pattern):
+            with open(os.path.join(ROOT, path)) as handle:
+                found = dict(re.findall(pattern, handle.read(), re.MULTILINE))
+            return {name: float(value) for name, value in found.items() if name in SimulatorConfig.defaults}
+        self.assertEqual(stated("friction_sim/include/friction_sim/ros/rig_simulator.h",
+                                r"^//\s+(\w+) \(double, ([^)]+)\)"), SimulatorConfig.defaults)
+        self.assertEqual(stated("docs/ros_api.md", r"^\| `(\w+)` \| double, ([^ |]+) \|"), SimulatorConfig.defaults)
 
     def test_the_launch_files_state_the_simulators_own_defaults(self):
         # An argument left '' leaves the simulator its default, which each doc names: the number must be
