@@ -239,6 +239,12 @@ USERS_LAUNCH = """<launch>
 
 
 class RigLaunchStatusTest(unittest.TestCase):
+    def work_folder(self):
+        """A folder of the test's own, removed after it."""
+        work = tempfile.mkdtemp(prefix="rig_launch_test_")
+        self.addCleanup(shutil.rmtree, work)
+        return work
+
     def assert_launch_fails(self, args, *said):
         """The launch with `args` (and no detector) exits 1 and its output holds each of `said`."""
         status, output = launch(*args, "analysis:=false")
@@ -285,8 +291,7 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertEqual(status, 2, output)
         self.assertIn("FRICTION_RIG_NETWORK: value 'public' is not allowed; allowed: private, host", output)
         # A system that refuses the namespace (here an unshare that always fails): the run goes on, warned.
-        work = tempfile.mkdtemp(prefix="rig_launch_test_")
-        self.addCleanup(shutil.rmtree, work)
+        work = self.work_folder()
         with open(os.path.join(work, "unshare"), "w") as refusing:
             refusing.write("#!/bin/sh\nexit 1\n")
         os.chmod(os.path.join(work, "unshare"), 0o755)
@@ -335,8 +340,7 @@ class RigLaunchStatusTest(unittest.TestCase):
     def test_a_stage_held_without_end_runs_on_and_stops_when_interrupted(self):
         # Unpaced, a held stage with nothing due and no end time jumped to t = inf, and the simulator
         # published forever without hearing the signal.
-        work = tempfile.mkdtemp(prefix="rig_launch_test_")
-        self.addCleanup(shutil.rmtree, work)
+        work = self.work_folder()
         protocol = os.path.join(work, "held.yaml")
         with open(protocol, "w") as handle:
             handle.write("steps:\n  - {action: hold, duration: .inf}\nend: {global_events: 1}\n")
@@ -352,8 +356,7 @@ class RigLaunchStatusTest(unittest.TestCase):
     def test_a_run_that_reaches_its_stop_condition_succeeds_with_paths_relative_to_the_users_directory(self):
         # The single block slips at µ_s·F_Z = 0.4 × 1920 N three times and stops (its scene's stop). The
         # nodes run elsewhere ($ROS_HOME): the scene and the bag are where the user's relative paths say.
-        work = tempfile.mkdtemp(prefix="rig_launch_test_")
-        self.addCleanup(shutil.rmtree, work)
+        work = self.work_folder()
         status, output = launch("scene:=" + os.path.relpath(SINGLE_BLOCK, work), "record:=true", "bag:=run.bag",
                                 "controller:=false", "analysis:=false", cwd=work)
         self.assertEqual(status, 0, output)
@@ -365,8 +368,7 @@ class RigLaunchStatusTest(unittest.TestCase):
         self.assertNotIn("\x1b", output)
 
     def test_a_second_rig_cannot_write_the_bag_a_rig_is_writing(self):
-        work = tempfile.mkdtemp(prefix="rig_launch_test_")
-        self.addCleanup(shutil.rmtree, work)
+        work = self.work_folder()
         bag = os.path.join(work, "run.bag")
         with SlowRun("real_time_factor:=0.01", "record:=true", "bag:=" + bag) as first:
             self.assertIsNotNone(first.simulator, "the simulator did not start")
@@ -489,8 +491,7 @@ class RigLaunchStatusTest(unittest.TestCase):
 
     def test_a_bag_that_cannot_be_written_further_ends_the_run_keeping_what_was_written(self):
         # Past a file size limit of 1 MiB the bag's writes fail, as on a full disk.
-        work = tempfile.mkdtemp(prefix="rig_launch_test_")
-        self.addCleanup(shutil.rmtree, work)
+        work = self.work_folder()
         bag = os.path.join(work, "run.bag")
         limit = 1 << 20
         done = subprocess.run([RIG_LAUNCH, RIG, "record:=true", "bag:=" + bag, "analysis:=false"],
@@ -531,8 +532,7 @@ class RigLaunchStatusTest(unittest.TestCase):
     def test_a_users_package_launches_the_rig_by_package_name_and_its_own_node(self):
         # A package of the user's, listed by hand on ROS_PACKAGE_PATH: its launch file includes the rig's
         # by package name and starts a node of its own, which marks that it ran.
-        work = tempfile.mkdtemp(prefix="rig_launch_test_")
-        self.addCleanup(shutil.rmtree, work)
+        work = self.work_folder()
         package = os.path.join(work, "users_analysis")
         os.makedirs(os.path.join(package, "launch"))
         with open(os.path.join(package, "package.xml"), "w") as handle:
