@@ -10,6 +10,7 @@
 #include "friction_sim/ros/stage_controller.h"
 #include "friction_sim/scene/config_error.h"
 #include "friction_sim/scene/scene_io.h"
+#include "friction_sim/solvers/integrator.h"
 
 namespace friction {
 namespace {
@@ -149,43 +150,45 @@ TEST(CommandChecks, BadCommandsAreRefusedWithAReason) {
   Scene scene;
   scene.model = ModelKind::Chain1D;
   scene.chain.blocks = 3;
-  const Simulation simulation(scene);
+  const RunDriver driver(scene, sceneStabilityLimit(scene));
+  const Simulation& simulation = driver.simulation();
   friction_msgs::StageCommand msg;
   msg.mode = friction_msgs::StageCommand::VELOCITY;
   msg.speed = -std::nan("");
-  EXPECT_NE(checkCommand(msg, simulation).find("speed nan m/s"), std::string::npos) << checkCommand(msg, simulation);
-  EXPECT_NE(checkCommand(msg, simulation).find("finite"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, driver).find("speed nan m/s"), std::string::npos) << checkCommand(msg, driver);
+  EXPECT_NE(checkCommand(msg, driver).find("finite"), std::string::npos);
   msg.speed = 2.0;
-  EXPECT_NE(checkCommand(msg, simulation).find("max_speed"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, driver).find("max_speed"), std::string::npos);
   msg.speed = 4e-4;
-  EXPECT_EQ(checkCommand(msg, simulation), "");
+  EXPECT_EQ(checkCommand(msg, driver), "");
   msg.mode = friction_msgs::StageCommand::NORMAL_LOAD;
   msg.normal_force = 2500.0;
-  EXPECT_EQ(checkCommand(msg, simulation), "");
+  EXPECT_EQ(checkCommand(msg, driver), "");
   msg.normal_force = -10.0;
-  EXPECT_NE(checkCommand(msg, simulation).find("normal load -10 N"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, driver).find("normal load -10 N"), std::string::npos);
   msg.normal_force = std::numeric_limits<double>::infinity();
-  EXPECT_NE(checkCommand(msg, simulation).find("finite F_Z"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, driver).find("finite F_Z"), std::string::npos);
   // Beyond a small strain (10⁹ N was accepted and the run went NaN).
   msg.normal_force = 1e9;
   const double largest = largestNormalForce(simulation.scene());
-  EXPECT_NE(checkCommand(msg, simulation).find("at most " + std::to_string(static_cast<int>(largest)) + " N"),
+  EXPECT_NE(checkCommand(msg, driver).find("at most " + std::to_string(static_cast<int>(largest)) + " N"),
             std::string::npos)
-      << checkCommand(msg, simulation);
+      << checkCommand(msg, driver);
   msg.mode = 9;
-  EXPECT_NE(checkCommand(msg, simulation).find("mode 9 is unknown"), std::string::npos);
+  EXPECT_NE(checkCommand(msg, driver).find("mode 9 is unknown"), std::string::npos);
 }
 
 TEST(CommandChecks, AHoldIgnoresTheSpeedAndTargetItCarries) {
   Scene scene;
   scene.model = ModelKind::Chain1D;
   scene.chain.blocks = 3;
-  Simulation simulation(scene);
+  RunDriver driver(scene, sceneStabilityLimit(scene));
+  Simulation& simulation = driver.simulation();
   friction_msgs::StageCommand msg;
   msg.mode = friction_msgs::StageCommand::HOLD;
   msg.speed = 5.0;  // beyond max_speed, and meaningless for a hold
   msg.target = std::nan("");
-  ASSERT_EQ(checkCommand(msg, simulation), "");
+  ASSERT_EQ(checkCommand(msg, driver), "");
   const TimedCommand hold = fromMsg(msg);
   EXPECT_EQ(hold.stage.mode, StageMode::Hold);
   // Accepted means applied: the stage, driven at the scene's speed before, stands still after.
@@ -199,11 +202,12 @@ TEST(CommandChecks, NormalLoadChangesAreRefusedWithTheSpringMattress) {
   scene.lattice.nodes_x = 29;  // square cells of 5 mm in the default 140 × 75 mm slider
   scene.lattice.nodes_z = 16;
   scene.load.top = TopLoadKind::SpringMattress;
-  Simulation simulation(scene);
+  RunDriver driver(scene, sceneStabilityLimit(scene));
+  Simulation& simulation = driver.simulation();
   friction_msgs::StageCommand msg;
   msg.mode = friction_msgs::StageCommand::NORMAL_LOAD;
   msg.normal_force = 2500.0;
-  EXPECT_NE(checkCommand(msg, simulation).find("spring_mattress"), std::string::npos) << checkCommand(msg, simulation);
+  EXPECT_NE(checkCommand(msg, driver).find("spring_mattress"), std::string::npos) << checkCommand(msg, driver);
   // Refused where it would be applied too, with the load unchanged.
   const double load = simulation.loadCells().normal_force;
   EXPECT_NE(simulation.setNormalLoad(2500.0), "");

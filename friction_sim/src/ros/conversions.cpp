@@ -180,7 +180,7 @@ TimedCommand fromMsg(const friction_msgs::StageCommand& msg) {
     case friction_msgs::StageCommand::POSITION:
       command.stage = {StageMode::Position, msg.speed, msg.target};
       break;
-    default:  // HOLD; an unknown mode is refused before (checkMode)
+    default:  // HOLD; an unknown mode is refused before (checkCommand)
       // A hold has no speed or target: the message's fields are left over from the sender, not asked for.
       command.stage = {StageMode::Hold, 0.0, 0.0};
       break;

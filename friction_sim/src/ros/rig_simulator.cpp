@@ -165,16 +165,11 @@ SimulatorOptions readSimulatorOptions(const ros::NodeHandle& pnh) {
   return o;
 }
 
-std::string checkMode(const friction_msgs::StageCommand& msg) {
+std::string checkCommand(const friction_msgs::StageCommand& msg, const RunDriver& driver) {
   if (msg.mode > friction_msgs::StageCommand::NORMAL_LOAD) {
     return "mode " + std::to_string(msg.mode) + " is unknown; allowed: 0 VELOCITY, 1 HOLD, 2 POSITION, 3 NORMAL_LOAD";
   }
-  return {};
-}
-
-std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulation& simulation) {
-  const std::string reason = checkMode(msg);
-  return reason.empty() ? simulation.checkCommand(fromMsg(msg)) : reason;
+  return driver.checkCommand(fromMsg(msg));
 }
 
 RigSimulator::RigSimulator(ros::NodeHandle nh, SimulatorOptions options)
@@ -448,14 +443,12 @@ void RigSimulator::publishLiveSnapshot() {
 }
 
 std::string RigSimulator::accept(const friction_msgs::StageCommand& msg) {
-  std::string reason = checkMode(msg);
-  const TimedCommand command = fromMsg(msg);
-  if (reason.empty()) reason = driver_->checkCommand(command);
+  const std::string reason = checkCommand(msg, *driver_);
   if (!reason.empty()) {
     ROS_WARN_STREAM("stage command refused: " << reason);
     return reason;
   }
-  driver_->schedule(command);
+  driver_->schedule(fromMsg(msg));
   return {};
 }
 

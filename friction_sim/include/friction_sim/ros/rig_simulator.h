@@ -85,7 +85,7 @@
 // was written), 4 when the run was aborted, 5 when ~wait_for_subscribers' subscribers did not come
 // within ~subscriber_timeout.
 //
-// A command that checkMode or RunDriver::checkCommand refuses (NaN/inf, a normal load out of range or
+// A command that checkCommand refuses (NaN/inf, a normal load out of range or
 // under a spring mattress, a speed beyond stage.max_speed, a POSITION speed <= 0, a stamp after the run's
 // known end, an unknown mode) is refused with a logged reason; the simulation keeps running. A HOLD's
 // speed and target are ignored: a hold has none.
@@ -163,10 +163,9 @@ std::vector<std::pair<std::string, int>> parseAwaitedSubscribers(const std::stri
 std::vector<std::string> validateOptions(const SimulatorOptions& options);
 /// Reads the options from the private parameters; throws ConfigError listing every problem.
 SimulatorOptions readSimulatorOptions(const ros::NodeHandle& private_nh);
-/// Why a command's mode must be refused (empty = a known mode).
-std::string checkMode(const friction_msgs::StageCommand& msg);
-/// Why a command must be refused (empty = acceptable): its mode, then what the simulation refuses.
-std::string checkCommand(const friction_msgs::StageCommand& msg, const Simulation& simulation);
+/// Why a command must be refused (empty = acceptable): an unknown mode, then what `driver` refuses
+/// (RunDriver::checkCommand: the simulation, then the run's end).
+std::string checkCommand(const friction_msgs::StageCommand& msg, const RunDriver& driver);
 
 /// Set by SIGINT/SIGTERM: the node finishes its bag and exits.
 extern std::atomic<bool> g_stop_requested;
