@@ -31,6 +31,11 @@ def arguments(launch_file):
     return ElementTree.parse(os.path.join(LAUNCH, launch_file)).getroot()
 
 
+def simulator_defaults_stated(pairs):
+    """{setting: value} of the (name, number as text) pairs that name one of the simulator's live settings."""
+    return {name: float(text) for name, text in pairs if name in SimulatorConfig.defaults}
+
+
 def host(config, name):
     """The address of the machine that runs node `name` ('' = this one, with no machine declared)."""
     machine = node(config, name).machine_name
@@ -117,25 +122,25 @@ class LaunchFilesTest(unittest.TestCase):
     def test_the_simulators_header_and_ros_api_state_its_own_defaults(self):
         # The header's parameter block and ros_api.md's table repeat the defaults for the reader: each
         # must be the simulator's (cfg/Simulator.cfg, checked against the node's options in test_conversions).
-        def stated(path, pattern):
+        for path, pattern in (("friction_sim/include/friction_sim/ros/rig_simulator.h",
+                               r"^//\s+(\w+) \(double, ([^)]+)\)"),
+                              ("docs/ros_api.md", r"^\| `(\w+)` \| double, ([^ |]+) \|")):
             with open(os.path.join(ROOT, path)) as handle:
-                found = dict(re.findall(pattern, handle.read(), re.MULTILINE))
-            return {name: float(value) for name, value in found.items() if name in SimulatorConfig.defaults}
-        self.assertEqual(stated("friction_sim/include/friction_sim/ros/rig_simulator.h",
-                                r"^//\s+(\w+) \(double, ([^)]+)\)"), SimulatorConfig.defaults)
-        self.assertEqual(stated("docs/ros_api.md", r"^\| `(\w+)` \| double, ([^ |]+) \|"), SimulatorConfig.defaults)
+                pairs = re.findall(pattern, handle.read(), re.MULTILINE)
+            self.assertEqual(simulator_defaults_stated(pairs), SimulatorConfig.defaults, path)
 
     def test_the_launch_files_state_the_simulators_own_defaults(self):
         # An argument left '' leaves the simulator its default, which each doc names: the number must be
         # the simulator's (cfg/Simulator.cfg, itself checked against the node's options in test_conversions).
         for launch_file in ("rig.launch", "multi_machine.launch"):
-            stated = {}
+            pairs = []
             for arg in arguments(launch_file).findall("arg"):
                 said = re.search(r"\((?:simulator )?default ([^)]+)\)", arg.get("doc", ""))
-                if said and arg.get("name") in SimulatorConfig.defaults:
-                    stated[arg.get("name")] = float(said.group(1))
-                    self.assertEqual(arg.get("default"), "", arg.get("name"))
-            self.assertEqual(stated, SimulatorConfig.defaults, launch_file)
+                if said:
+                    pairs.append((arg.get("name"), said.group(1)))
+                    if arg.get("name") in SimulatorConfig.defaults:
+                        self.assertEqual(arg.get("default"), "", arg.get("name"))
+            self.assertEqual(simulator_defaults_stated(pairs), SimulatorConfig.defaults, launch_file)
 
     def test_the_simulator_waits_for_the_subscribers_it_is_given(self):
         config = load("rig.launch", "wait_for_subscribers:=load_cells interface:2", "subscriber_timeout:=5")
