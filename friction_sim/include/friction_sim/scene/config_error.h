@@ -12,11 +12,15 @@ namespace friction {
 /// naming the field, the value and what is allowed.
 class ConfigError : public std::runtime_error {
  public:
-  ConfigError(const std::string& what_was_refused, std::vector<std::string> problems);
+  /// `notes`: what the problems kept from being checked; listed after them, not counted among them.
+  ConfigError(const std::string& what_was_refused, std::vector<std::string> problems,
+              std::vector<std::string> notes = {});
   const std::vector<std::string>& problems() const { return problems_; }
+  const std::vector<std::string>& notes() const { return notes_; }
 
  private:
   std::vector<std::string> problems_;
+  std::vector<std::string> notes_;
 };
 
 /// A refused value as refusals write it: ten digits, and NaN as "nan" whatever its sign bit, which the

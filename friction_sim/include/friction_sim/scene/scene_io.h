@@ -13,10 +13,11 @@
 namespace friction {
 
 /// Thrown when a scene is refused; `problems()` holds one message per problem, each naming the
-/// field, the value and what is allowed.
+/// field, the value and what is allowed; `notes()` what they kept from being checked.
 class SceneError : public ConfigError {
  public:
-  explicit SceneError(std::vector<std::string> problems) : ConfigError("scene", std::move(problems)) {}
+  explicit SceneError(std::vector<std::string> problems, std::vector<std::string> notes = {})
+      : ConfigError("scene", std::move(problems), std::move(notes)) {}
 };
 
 /// Parses a scene from YAML text; fields absent from the text keep the defaults of `base`.
@@ -35,10 +36,18 @@ Scene loadScene(const std::string& path, const std::vector<std::pair<std::string
 Scene overrideScene(const Scene& base, const std::vector<std::pair<std::string, std::string>>& overrides,
                     double* stability_limit = nullptr);
 
-/// Every problem of a scene (empty when valid): ranges, cross-field constraints, dt stability. When
-/// the model's own fields are valid and `stability_limit` is given, it receives the scene's stability
-/// limit (s), which the check computes anyway.
-std::vector<std::string> validateScene(const Scene& scene, double* stability_limit = nullptr);
+/// What a scene's check found.
+struct SceneReview {
+  std::vector<std::string> problems;  ///< each refuses the scene; none when it is valid
+  /// The checks the problems kept from running (dt's stability needs a valid model), so that mending
+  /// the problems does not meet a new refusal unannounced.
+  std::vector<std::string> notes;
+};
+
+/// Every problem of a scene: ranges, cross-field constraints, dt stability. When the model's own
+/// fields are valid and `stability_limit` is given, it receives the scene's stability limit (s), which
+/// the check computes anyway.
+SceneReview validateScene(const Scene& scene, double* stability_limit = nullptr);
 
 /// N, the largest F_Z the scene takes: a mean normal stress F_Z/(L·B) of 5 % of E. Beyond it the
 /// slider's compression is no small strain, which its linear elasticity assumes (F_Z = 10⁶ N, 40 % of E

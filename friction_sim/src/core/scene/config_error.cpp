@@ -6,14 +6,17 @@
 
 namespace friction {
 
-ConfigError::ConfigError(const std::string& what_was_refused, std::vector<std::string> problems)
+ConfigError::ConfigError(const std::string& what_was_refused, std::vector<std::string> problems,
+                         std::vector<std::string> notes)
     : std::runtime_error([&] {
         std::string text = what_was_refused + " refused (" + std::to_string(problems.size()) + " problem" +
                            (problems.size() == 1 ? "" : "s") + "):";
         for (const auto& problem : problems) text += "\n  - " + problem;
+        for (const auto& note : notes) text += "\n  note: " + note;
         return text;
       }()),
-      problems_(std::move(problems)) {}
+      problems_(std::move(problems)),
+      notes_(std::move(notes)) {}
 
 std::string refusedValueText(double value) {
   if (std::isnan(value)) return "nan";

@@ -249,8 +249,9 @@ Scene readFields(const std::string& yaml_text, const std::string& source, const 
 
 /// Validates even after parse problems, so that one refusal lists everything wrong.
 Scene validated(const Scene& scene, std::vector<std::string>& problems, double* stability_limit) {
-  for (auto& problem : validateScene(scene, stability_limit)) problems.push_back(std::move(problem));
-  if (!problems.empty()) throw SceneError(problems);
+  SceneReview review = validateScene(scene, stability_limit);
+  for (auto& problem : review.problems) problems.push_back(std::move(problem));
+  if (!problems.empty()) throw SceneError(problems, std::move(review.notes));
   return scene;
 }
 
@@ -326,8 +327,8 @@ std::string sceneToYaml(const Scene& scene) {
 
 double requireValidScene(const Scene& scene) {
   double limit = 0.0;
-  auto problems = validateScene(scene, &limit);
-  if (!problems.empty()) throw SceneError(problems);
+  SceneReview review = validateScene(scene, &limit);
+  if (!review.problems.empty()) throw SceneError(std::move(review.problems), std::move(review.notes));
   return limit;
 }
 

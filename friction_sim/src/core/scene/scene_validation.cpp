@@ -59,20 +59,24 @@ void checkLattice(Checker& check, const Scene& s) {
   if (s.lattice.nodes_x >= 2 && s.lattice.nodes_z >= 2 && s.geometry.length > 0 && s.geometry.height > 0) {
     const double spacing_x = s.geometry.length / (s.lattice.nodes_x - 1);
     const double spacing_z = s.geometry.height / (s.lattice.nodes_z - 1);
-    const bool square = std::abs(spacing_x - spacing_z) <= 1e-6 * spacing_x;
-    std::ostringstream allowed;
-    allowed << "a square lattice: geometry.height/(nodes_z-1) = " << spacing_z
-            << " m must equal geometry.length/(nodes_x-1) = " << spacing_x << " m";
-    // The sizes that fit, so that whichever of the two was changed can be matched.
-    for (int intervals_x = 1; !square && intervals_x <= 10000; ++intervals_x) {
-      const double intervals_z = intervals_x * s.geometry.height / s.geometry.length;
-      if (std::abs(intervals_z - std::round(intervals_z)) > 1e-6 * intervals_z || std::round(intervals_z) < 1) continue;
-      allowed << "; sizes that fit " << s.geometry.length << " m x " << s.geometry.height
-              << " m: nodes_x - 1 a multiple of " << intervals_x << ", e.g. nodes_x: " << 2 * intervals_x + 1
-              << ", nodes_z: " << 2 * std::lround(intervals_z) + 1;
-      break;
+    if (std::abs(spacing_x - spacing_z) > 1e-6 * spacing_x) {
+      // Either count may be the one changed: the refusal names both, and the sizes that fit.
+      std::ostringstream text;
+      text << "lattice.nodes_x/lattice.nodes_z: values " << s.lattice.nodes_x << ", " << s.lattice.nodes_z
+           << " are not allowed; allowed: a square lattice: geometry.height/(nodes_z-1) = " << spacing_z
+           << " m must equal geometry.length/(nodes_x-1) = " << spacing_x << " m";
+      for (int intervals_x = 1; intervals_x <= 10000; ++intervals_x) {
+        const double intervals_z = intervals_x * s.geometry.height / s.geometry.length;
+        if (std::abs(intervals_z - std::round(intervals_z)) > 1e-6 * intervals_z || std::round(intervals_z) < 1) {
+          continue;
+        }
+        text << "; sizes that fit " << s.geometry.length << " m x " << s.geometry.height
+             << " m: nodes_x - 1 a multiple of " << intervals_x << ", e.g. nodes_x: " << 2 * intervals_x + 1
+             << ", nodes_z: " << 2 * std::lround(intervals_z) + 1;
+        break;
+      }
+      check.problems.push_back(text.str());
     }
-    check.require(square, "lattice.nodes_z", s.lattice.nodes_z, allowed.str());
   }
   check.positive("lattice.foundation_ratio", s.lattice.foundation_ratio);
   check.within("instruments.gauge_height", s.instruments.gauge_height, 0.0, s.geometry.height,
@@ -325,7 +329,7 @@ double largestNormalForce(const Scene& scene) {
   return 0.05 * scene.material.youngs_modulus * scene.geometry.length * scene.geometry.width;
 }
 
-std::vector<std::string> validateScene(const Scene& s, double* stability_limit) {
+SceneReview validateScene(const Scene& s, double* stability_limit) {
   Checker check;
   const bool lattice = s.model == ModelKind::Lattice2D;
   checkBody(check, s);
@@ -346,21 +350,20 @@ std::vector<std::string> validateScene(const Scene& s, double* stability_limit) 
   const bool model_valid = check.clean({"geometry.", "material.", "lattice.", "chain.", "pusher.", "load.",
                                         "friction.interfacial_stiffness", "integrator."});
   if (!model_valid) {
-    // dt's limit needs a valid model. Saying that dt is still to be checked keeps a fix of the problems
-    // above from meeting a new refusal unannounced.
+    SceneReview review{check.problems, {}};
     if (check.clean({"integrator.time_step"})) {
       std::ostringstream text;
       text << "integrator.time_step: value " << s.integrator.time_step
            << " not yet checked against the stability limit, which needs the fields above to be valid";
-      check.problems.push_back(text.str());
+      review.notes.push_back(text.str());
     }
-    return check.problems;
+    return review;
   }
   if (!lattice && check.clean({"friction.static_coefficient"})) checkChainStatics(check, s);
   if (lattice) checkFoundation(check, s);
   const double limit = checkTimeStep(check, s);
   if (stability_limit) *stability_limit = limit;
-  return check.problems;
+  return {check.problems, {}};
 }
 
 std::vector<std::string> sceneWarnings(const Scene& s) {
