@@ -13,6 +13,7 @@ import unittest
 import rosbag
 import rospy
 import rosunit
+from friction_sim import results
 from friction_msgs.msg import InterfaceState, SlipEvent, StageCommand, StageState
 from geometry_msgs.msg import WrenchStamped
 from std_msgs.msg import String
@@ -253,5 +254,88 @@ class RigReportTest(unittest.TestCase):
         self.assertEqual([row["length_ratio"] for row in self.table()], ["nan", "nan"])
 
 
+def write_results_folder(folder):
+    """A friction_run folder: its scene, a loading curve and four events, one of each kind the rule tells
+    apart but back-slips (the columns of results.EVENT_COLUMNS, unused ones 0)."""
+    os.makedirs(folder)
+    with open(os.path.join(folder, "scene.yaml"), "w") as handle:
+        handle.write(SCENE)
+    with open(os.path.join(folder, "loading.csv"), "w") as handle:
+        handle.write("time_s,stage_position_m,shear_force_N,normal_force_N,interface_normal_sum_N,sliding_nodes\n")
+        for step in range(101):
+            handle.write("%g,0,%g,%g,%g,0\n" % (step * 1e-3, 4.0 * step, F_Z, F_Z))
+    # onset (s), F_X/F_Z, L_p (m), global: a precursor, a single-node slip, the global slip, a later one.
+    events = [(0.02, 0.05, 0.03, 0), (0.04, 0.08, 0.0, 0), (0.06, 0.12, 0.14, 1), (0.09, 0.1, 0.05, 0)]
+    with open(os.path.join(folder, "events.csv"), "w", newline="") as handle:
+        writer = csv.DictWriter(handle, results.EVENT_COLUMNS, restval=0, lineterminator="\n")
+        writer.writeheader()
+        for index, (onset, ratio, length, glob) in enumerate(events):
+            writer.writerow({"index": index, "onset_time_s": onset, "end_time_s": onset + 0.001, "shear_ratio": ratio,
+                             "onset_shear_force_N": ratio * F_Z, "onset_normal_force_N": F_Z,
+                             "rupture_length_m": length, "length_ratio": length / 0.14, "global": glob,
+                             "mean_slip_m": 1e-6})
+
+
+class RigReportFolderTest(unittest.TestCase):
+    """A friction_run folder: the loading curve and the precursors, the events classified by the rule
+    the simulator applies, and the folder's own tables left as they are."""
+
+    def setUp(self):
+        self.work = tempfile.mkdtemp(prefix="rig_report_folder_test_")
+        self.addCleanup(shutil.rmtree, self.work)
+        self.folder = os.path.join(self.work, "run")
+        write_results_folder(self.folder)
+
+    def report(self, *args):
+        return subprocess.run(["/usr/bin/python3", RIG_REPORT, self.folder, "--format", "svg"] + list(args),
+                              capture_output=True, text=True, timeout=120)
+
+    def test_its_figures_classify_each_event_and_leave_its_tables_alone(self):
+        with open(os.path.join(self.folder, "events.csv"), "rb") as handle:
+            table = handle.read()
+        done = self.report()
+        self.assertEqual(done.returncode, 0, done.stderr)
+        self.assertIn("no slip map", done.stdout)
+        self.assertFalse(os.path.exists(os.path.join(self.folder, "slip_map.svg")))
+        with open(os.path.join(self.folder, "events.csv"), "rb") as handle:
+            self.assertEqual(handle.read(), table)
+        with open(os.path.join(self.folder, "precursors.svg")) as svg:
+            text = svg.read()
+        self.assertIn("synthetic: precursor length against load", text)
+        for label in ["precursor (an arrested front)", "single-node slip (L_p = 0)", "global slip",
+                      "arrested after a global slip"]:
+            self.assertIn(label, text)
+        self.assertNotIn("back-slip", text)
+        with open(os.path.join(self.folder, "loading_curve.svg")) as svg:
+            text = svg.read()
+        self.assertIn("F_X / F_Z (F_Z = 1920 N)", text)
+        # The printed table: one row per event, its L_p/L from the folder.
+        rows = [line.split() for line in done.stdout.splitlines() if line.split()[:1] in (["0"], ["1"], ["2"], ["3"])]
+        self.assertEqual([row[3] for row in rows], ["0.2143", "0.0000", "1.0000", "0.3571"])
+
+    def test_an_other_out_folder_gets_copies_of_its_tables(self):
+        out = os.path.join(self.work, "figures")
+        done = self.report("--out", out)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        for name in ["scene.yaml", "events.csv"]:
+            with open(os.path.join(self.folder, name), "rb") as source, open(os.path.join(out, name), "rb") as copy:
+                self.assertEqual(copy.read(), source.read(), name)
+        self.assertTrue(os.path.exists(os.path.join(out, "loading_curve.svg")))
+
+    def test_a_folder_without_events_is_refused_in_a_sentence(self):
+        os.remove(os.path.join(self.folder, "events.csv"))
+        done = self.report()
+        self.assertNotEqual(done.returncode, 0)
+        self.assertIn("holds no events.csv: not a results folder", done.stderr)
+        self.assertNotIn("Traceback", done.stderr)
+
+
+def all_tests():
+    """Both classes, in one results file."""
+    loader = unittest.TestLoader()
+    return unittest.TestSuite([loader.loadTestsFromTestCase(RigReportTest),
+                               loader.loadTestsFromTestCase(RigReportFolderTest)])
+
+
 if __name__ == "__main__":
-    rosunit.unitrun("friction_sim", "rig_report", RigReportTest)
+    rosunit.unitrun("friction_sim", "rig_report", "__main__.all_tests")
