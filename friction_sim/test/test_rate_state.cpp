@@ -93,16 +93,71 @@ TEST(RateAndStateLaw, KicksEndSpeedIsTheSameRootFromAnyFirstGuess) {
   }
 }
 
-TEST_F(OneAgeingNode, NodeThatFrictionAtRestWouldStopEndsItsKickMovingBackToReStick) {
-  ASSERT_TRUE(update(9.0, 10.0));
-  v_[0] = 1e-6;
-  const double kick = 1e-4, mu_rest = spec().staticCoefficient(law().age(0));
-  const double acceleration = net(0.0, 10.0, kick);
-  // No forward speed solves y + kick·N·µ(y) = reach: friction at rest acts, and the velocity crosses
-  // zero within the kick, where the re-stick rule stops the node.
-  EXPECT_NEAR(contact_.frictionForce(0), -mu_rest * 10.0, 1e-12);
-  EXPECT_LT(v_[0] + kick * acceleration, 0.0);
+/// The law's branches one after another in either direction: the parameter is the way the node is
+/// pushed and slides (+1: +x).
+class OneAgeingNodeEitherWay : public OneAgeingNode, public ::testing::WithParamInterface<double> {};
+
+TEST_P(OneAgeingNodeEitherWay, HoldsUnsticksSlidesAndReSticksWhereItsVelocityCrossesZero) {
+  const double direction = GetParam(), normal = 10.0, dt = 1e-4;
+  contact_.setTime(1.0);
+  const double mu_s = spec().staticCoefficient(11.0);  // 10 s old at the start, 1 s later
+  // Stick: it carries whatever holds it, up to µ(0, φ)·N.
+  EXPECT_FALSE(update(direction * 0.999 * mu_s * normal, normal));
+  EXPECT_DOUBLE_EQ(contact_.frictionForce(0), -direction * 0.999 * mu_s * normal);
+  // Stick → slip beyond it, sliding the way it was pushed.
+  ASSERT_TRUE(update(direction * 1.001 * mu_s * normal, normal));
+  ASSERT_EQ(contact_.state(0), ContactState::Sliding);
+  EXPECT_EQ(contact_.slidingDirection(0), direction);
+  contact_.beginStep(u_, v_);
+  contact_.finishStep(u_, v_, dt);  // the step after unsticking, in which it may not re-stick
+  // Sliding at 1 mm/s under 9 N: friction and the kick's end speed solved together,
+  // |v_end| = |v| + kick·(9 − µ(|v_end|, φ)·N) and f = −sgn(v)·µ(|v_end|, φ)·N.
+  const double kick = 0.5 * dt, age = law().age(0);
+  v_[0] = direction * 1e-3;
+  net(direction * 9.0, normal, kick);
+  const double force = contact_.frictionForce(0);
+  const double end_speed = 1e-3 + kick * (9.0 - std::abs(force));
+  EXPECT_EQ(std::copysign(1.0, force), -direction);
+  EXPECT_NEAR(std::abs(force), spec().coefficient(end_speed, age) * normal, 1e-12);
+  EXPECT_GT(end_speed, 1e-3);  // pushed beyond µ·N: it speeds up
+  // Re-stick: unloaded at 10 µm/s, no forward speed balances the friction, which acts at rest, −µ(0, φ)·N,
+  // and the velocity falls through zero within the step. Velocity Verlet's step, then the state update.
+  const double start_speed = 1e-5, start_u = u_[0];
+  v_[0] = direction * start_speed;
+  const double acceleration = net(0.0, normal, kick);
+  EXPECT_NEAR(acceleration, -direction * spec().staticCoefficient(age) * normal, 1e-12);
+  contact_.beginStep(u_, v_);
+  u_[0] += (v_[0] + 0.5 * acceleration * dt) * dt;
+  v_[0] += acceleration * dt;
+  EXPECT_TRUE(contact_.finishStep(u_, v_, dt));
+  EXPECT_EQ(contact_.state(0), ContactState::Stuck);
+  // Where the velocity, linear over the step, reaches zero: after start_speed/|a|, having slid half
+  // start_speed over that time.
+  const double fraction = start_speed / (std::abs(acceleration) * dt);
+  EXPECT_NEAR(contact_.transitionFraction(0), fraction, 1e-12);
+  EXPECT_NEAR(u_[0], start_u + direction * 0.5 * start_speed * fraction * dt, 1e-18);
+  EXPECT_EQ(v_[0], 0.0);
 }
+
+TEST_P(OneAgeingNodeEitherWay, LandingWhileMovingSlidesOnAsANewContact) {
+  const double direction = GetParam(), normal = 10.0;
+  contact_.setTime(5.0);
+  ASSERT_TRUE(update(0.0, 0.0));
+  ASSERT_EQ(contact_.state(0), ContactState::Detached);
+  v_[0] = direction * 0.2;
+  ASSERT_TRUE(update(0.0, normal));
+  EXPECT_EQ(contact_.state(0), ContactState::Sliding);
+  EXPECT_EQ(law().age(0), 0.0);
+  // Outside a step (no kick) its friction is µ at its speed with the new contact's age of 0:
+  // f0 + a·ln(1 + 0.2/v*), against its motion.
+  net(0.0, normal);
+  EXPECT_NEAR(contact_.frictionForce(0), -direction * (0.285 + 0.005 * std::log1p(0.2 / 1e-7)) * normal, 1e-12);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothDirections, OneAgeingNodeEitherWay, ::testing::Values(1.0, -1.0),
+                         [](const ::testing::TestParamInfo<double>& info) {
+                           return std::string(info.param > 0 ? "PlusX" : "MinusX");
+                         });
 
 TEST_F(OneAgeingNode, SlipRenewsTheContactsByTheAgeingLawsExactSolution) {
   ASSERT_TRUE(update(9.0, 10.0));
