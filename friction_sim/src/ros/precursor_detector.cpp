@@ -117,10 +117,14 @@ void PrecursorDetector::onLoadCells(const geometry_msgs::WrenchStamped::ConstPtr
 
 void PrecursorDetector::onFrame(const friction_msgs::InterfaceState::ConstPtr& msg) {
   checkTime(msg->header.stamp);
+  const std::string left_out = detector_->addFrame(fromMsg(*msg));
+  if (!left_out.empty()) {
+    ROS_WARN_STREAM_THROTTLE(5.0, "precursor detector: " << left_out);
+    return;
+  }
   positions_ = msg->position;
   frame_id_ = msg->header.frame_id;
   ++frames_seen_;
-  detector_->addFrame(fromMsg(*msg));
   publishCompleted();
 }
 

@@ -10,6 +10,7 @@
 #include <deque>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "friction_sim/instruments/instruments.h"
@@ -27,8 +28,9 @@ class FrameEventDetector {
 
   /// Load-cell samples, in time order.
   void addLoadCells(const LoadCellReading& reading);
-  /// Interface frames, in time order.
-  void addFrame(const InterfaceFrame& frame);
+  /// Interface frames, in time order. A frame whose arrays differ in length, or that has another number
+  /// of nodes than the event under way, is left out: returns why ("" when taken).
+  std::string addFrame(const InterfaceFrame& frame);
   /// Events that have ended and whose load-cell readings have arrived (the two topics travel
   /// separately, so the load cells of an event's last step may come after its last frame); with
   /// `no_more_readings`, every ended event, from the readings there are (the stream restarts).

@@ -25,7 +25,8 @@
 //
 // Bad parameters or a refused scene end the node at start (exit status 2), every problem listed.
 //
-// When time jumps backwards (looped playback), it forgets everything and starts over.
+// When time jumps backwards (looped playback), it forgets everything and starts over. A frame whose arrays
+// differ in length, or whose node count changes during an event, is left out with a warning.
 #pragma once
 
 #include <friction_msgs/InterfaceState.h>

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <sstream>
 
 namespace friction {
 
@@ -82,8 +83,22 @@ void FrameEventDetector::addLoadCellsTo(SlipEvent& event) const {
   event.mean_normal_force = span > 0.0 ? normal_impulse / span : event.onset_normal_force;
 }
 
-void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
+std::string FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   const std::size_t n = frame.position.size();
+  // Frames come from outside (a topic, a bag): the per-node arrays index one another.
+  const bool consistent = frame.state.size() == n && frame.slip.size() == n &&
+                          (frame.slip_velocity.empty() || frame.slip_velocity.size() == n);
+  if (!consistent || (in_event_ && n != current_.peak_slip_velocity.size())) {
+    std::ostringstream reason;
+    reason << "the frame at t = " << frame.time << " s is left out: ";
+    if (!consistent) {
+      reason << "its arrays differ in length (" << n << " positions, " << frame.state.size() << " states, "
+             << frame.slip.size() << " slips, " << frame.slip_velocity.size() << " slip velocities)";
+    } else {
+      reason << "it has " << n << " nodes, the event under way " << current_.peak_slip_velocity.size();
+    }
+    return reason.str();
+  }
   last_frame_time_ = frame.time;
   if (n > 0) frames_length_ = frame.position.back();
   std::vector<char> slipping(n);
@@ -98,7 +113,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   if (!in_event_) {
     if (!any_slipping || !last_stuck_frame_ || last_stuck_frame_->position.size() != n) {
       if (!any_slipping) last_stuck_frame_ = frame;
-      return;
+      return {};
     }
     in_event_ = true;
     current_ = SlipEvent{};
@@ -126,10 +141,10 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   }
   if (any_slipping) {
     quiet_frame_.reset();
-    return;
+    return {};
   }
   if (!quiet_frame_) quiet_frame_ = frame;
-  if (frame.time - quiet_frame_->time < criterion_.quiet_time) return;
+  if (frame.time - quiet_frame_->time < criterion_.quiet_time) return {};
 
   in_event_ = false;
   SlipEvent event = std::move(current_);
@@ -146,6 +161,7 @@ void FrameEventDetector::addFrame(const InterfaceFrame& frame) {
   last_stuck_frame_ = frame;
   quiet_frame_.reset();
   ended_.push_back(std::move(event));
+  return {};
 }
 
 }  // namespace friction
