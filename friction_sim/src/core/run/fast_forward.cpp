@@ -26,10 +26,13 @@ StaticSolver* FastForward::pinnedSolver(LoadingSolve* loading) {
   for (int node = 0; node < contact.size(); ++node) {
     if (contact.state(node) == ContactState::Detached) lifted.push_back(node);
   }
-  if (lifted != lifted_nodes_ || (lifted_nodes_.empty() && !pinned_solver_)) {
+  // A set whose setup failed is not tried again until the set changes: a failed factorisation or
+  // multigrid setup would otherwise be repeated at every advance.
+  if (!set_up_ || lifted != lifted_nodes_) {
     creep_.forget();  // it knows its solver by address, which a solver taken back from the spare reuses
     std::unique_ptr<StaticSolver> solver = exchangeWithSpare(lifted);
     lifted_nodes_.swap(lifted);
+    set_up_ = true;
     std::vector<int> in_contact;
     for (int node = 0; node < contact.size(); ++node) {
       if (contact.state(node) != ContactState::Detached) in_contact.push_back(contact.dofs()[node]);

@@ -164,6 +164,7 @@ class FastForward {
   double next_creep_resume_ = 0.0;               ///< s, creepResumeDue's next time
   std::unique_ptr<StaticSolver> pinned_solver_;  ///< see pinnedSolver(); null when its stiffness is singular
   std::vector<int> lifted_nodes_;                ///< the interface nodes off the track it was set up for
+  bool set_up_ = false;                          ///< a setup was tried for lifted_nodes_ (null if it failed)
   /// The solver before, kept for when its contact set comes back: a corner that lifts and lands again
   /// toggles between two sets (449 × 241: 15 factorisations of 4 s to the first global event, all but two
   /// of them repeats). Kept up to kLargestSpareFactor bytes; never a multigrid solver.
