@@ -142,6 +142,8 @@ class Lattice2D : public Model {
   bool interface_free_while_loading_;
   double mattress_k_, mattress_kx_per_node_;
   double plate_z_ = 0.0;              ///< m, displacement of the mattress plate
+  double last_plate_move_ = 0.0;      ///< m, rebalanceLoad's last move of the plate (0: none yet)
+  double last_excess_ = 0.0;          ///< N, the load carried beyond F_Z before that move
   std::vector<double> top_anchor_x_;  ///< m, where the mattress holds each top node in x
   std::vector<int> pushed_rows_;
   double pusher_k_per_row_;
