@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "friction_sim/scene/scene_io.h"
 #include "friction_sim/solvers/static_solver.h"
@@ -58,7 +59,10 @@ void Simulation::relaxToLoadedEquilibrium() {
   }
   FastForward::LoadingSolve loading{nullptr, model_->blockedDofsDuringLoading(), Vector()};
   loading.solver = std::make_unique<StaticSolver>(*model_, loading.fixed_dofs, true);
-  loading.solver->solve(*model_, u_, 0.0, body_force);
+  if (loading.solver->solve(*model_, u_, 0.0, body_force) > StaticSolver::kMaxIterations) {
+    throw std::runtime_error("no equilibrium within " + std::to_string(StaticSolver::kMaxIterations) +
+                             " modified-Newton corrections");
+  }
   loading.anchor_stiffness = model_->anchorStiffness();
   if (!prestressed) model_->connectPusher(u_);
   contact_.reset(u_);

@@ -239,6 +239,7 @@ int StaticSolver::solve(Model& model, Vector& u, double stage_position, const Ve
   bool single_precision = true;
   for (int iteration = 1; iteration <= kMaxIterations; ++iteration) {
     const double correction = correct(model, u, stage_position, body_force, single_precision);
+    if (!std::isfinite(correction)) return kMaxIterations + 1;  // no later correction would be finite
     const bool load_changed = balance_load_ && model.rebalanceLoad(u);
     const bool measured = last_correction > 0.0 && std::isfinite(last_correction);
     const double ratio = measured ? correction / last_correction : kLargestTrustedRatio;
