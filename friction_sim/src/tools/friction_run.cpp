@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "friction_sim/instruments/results_io.h"
+#include "friction_sim/model/lattice_2d.h"
 #include "friction_sim/run/run_driver.h"
 #include "friction_sim/scene/scene_io.h"
 #include "process_memory.h"
@@ -44,7 +45,9 @@ int help() {
                "  --set key=value...  overrides scene fields (SI units), validated like the file\n"
                "  --commands FILE  drives the stage and F_Z by a command table (rig_report's stage_commands.csv)\n"
                "  --protocol FILE  runs a stage controller's loading protocol from t = 0; its end ends the run\n"
-               "  --threads N  threads for the 2D lattice's force sweeps, used from 10^3 nodes (default 1);\n"
+               "  --threads N  threads for the 2D lattice's force sweeps, used from "
+            << friction::Lattice2D::kThreadedNodes
+            << " nodes (default 1);\n"
                "               the same results for any N\n"
                "Exit status: 0 the run ended, 2 a bad command line, 3 a refused scene, command table or protocol,\n"
                "4 DIR cannot be written. On a terminal, a progress line on standard error.\n"

@@ -29,8 +29,9 @@ class Lattice2D : public Model {
   static double springStiffness(const Scene& scene) {
     return 0.75 * scene.geometry.width * scene.material.youngs_modulus;
   }
-  double dampingRate() const { return eta_; }         ///< kg/s, η
-  double foundationStiffness() const { return kf_; }  ///< N/m, k_f
+  /// Pa, the lattice's shear modulus G = 3E/8 (ν = 1/3, MODEL.md §7.3).
+  static double shearModulus(const Scene& scene) { return 3.0 / 8.0 * scene.material.youngs_modulus; }
+  double dampingRate() const { return eta_; }  ///< kg/s, η
   int nodeIndex(int i, int j) const { return j * nx_ + i; }
   int xDof(int node) const { return node; }
   int zDof(int node) const { return n_ + node; }

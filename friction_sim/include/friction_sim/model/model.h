@@ -268,6 +268,9 @@ class Model {
   }
   /// m, rest spacing of the nodes (l or a).
   virtual double nodeSpacing() const = 0;
+  /// m, the displacement of the forces' finite differences (fast-forward's path, the creep's
+  /// linearisation): a millionth of a spacing, far above round-off and far below the springs' curvature.
+  double probeLength() const { return 1e-6 * nodeSpacing(); }
 };
 
 std::unique_ptr<Model> buildModel(const Scene& scene);

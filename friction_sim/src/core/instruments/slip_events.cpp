@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "friction_sim/model/lattice_2d.h"
+
 namespace friction {
 
 double SlipEvent::meanSlip() const {
@@ -294,7 +296,7 @@ WaveSpeeds waveSpeeds(const Scene& scene) {
     const double bar = std::sqrt(E / rho);
     return {bar, bar, 0.0};
   }
-  const double shear = std::sqrt(3.0 * E / 8.0 / rho);
+  const double shear = std::sqrt(Lattice2D::shearModulus(scene) / rho);
   return {std::sqrt(3.0) * shear, shear, kRayleighFraction * shear};
 }
 

@@ -212,7 +212,7 @@ FastForward::Path FastForward::pathAhead(double span) {
   // path every free node moves at speed·along, and the pair damping's force on the stuck nodes
   // counts towards their thresholds, as it does once the dynamics takes over.
   path.velocity = speed * path.along;
-  const double probe = 1e-6 * model.nodeSpacing();
+  const double probe = model.probeLength();
   ForceEvaluation here, moved;
   model.evaluate(s.u_, path.velocity, s.stage_.position(), here);
   const Vector probed = s.u_ + probe * path.along;

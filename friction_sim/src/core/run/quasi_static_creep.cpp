@@ -28,7 +28,7 @@ void QuasiStaticCreep::linearise(const StaticSolver& solver, const ForceEvaluati
   const double stage = s.stage().position();
   const int columns = static_cast<int>(nodes_.size()) + 1;
   const Vector at_rest = Vector::Zero(u.size());
-  const double probe = 1e-6 * model.nodeSpacing();
+  const double probe = model.probeLength();
   // A creeping node moved with every other node in contact pinned and the bulk in equilibrium, or the
   // stage moved with the whole interface pinned: each column's force with its unit motion alone, then
   // the bulk's responses to a sweep's worth of columns at once (more would only hold more memory).

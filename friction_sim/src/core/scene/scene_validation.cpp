@@ -399,8 +399,7 @@ std::vector<std::string> sceneWarnings(const Scene& s) {
     // What the lattice must resolve is the cohesive zone, where the friction weakens, not ξ_µ itself: an
     // estimate is Λ ≈ G·ξ_µ/((µ_s − µ_k)·σ̄), G the shear modulus (the chain's E: it only stretches) and
     // σ̄ = F_Z/(L·B) the mean normal stress. The warning gives it so that the user can judge.
-    const double modulus =
-        s.model == ModelKind::Lattice2D ? 3.0 / 8.0 * s.material.youngs_modulus : s.material.youngs_modulus;
+    const double modulus = s.model == ModelKind::Lattice2D ? Lattice2D::shearModulus(s) : s.material.youngs_modulus;
     const double mean_normal_stress = s.load.normal_force / (s.geometry.length * s.geometry.width);
     const double strength_drop = (s.friction.static_coefficient - s.friction.kinetic_coefficient) * mean_normal_stress;
     std::ostringstream text;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "solvers/cholesky_factor.h"
@@ -206,7 +207,8 @@ Vector GridMultigrid::solve(const Vector& rhs, double relative_tolerance) const 
     direction = preconditioned + (next_along / along) * direction;
     along = next_along;
   }
-  throw std::runtime_error("multigrid: conjugate gradients did not converge in 500 iterations");
+  throw std::runtime_error("multigrid: conjugate gradients did not converge in " + std::to_string(kMaxIterations) +
+                           " iterations");
 }
 
 }  // namespace friction

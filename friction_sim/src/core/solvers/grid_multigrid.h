@@ -30,7 +30,7 @@ class GridMultigrid {
   ~GridMultigrid();
 
   /// Solves matrix·x = rhs until ‖rhs − matrix·x‖ ≤ relative_tolerance·‖rhs‖. Throws
-  /// std::runtime_error if that is not reached within 500 iterations.
+  /// std::runtime_error if conjugate gradients do not reach it.
   Vector solve(const Vector& rhs, double relative_tolerance) const;
   /// Conjugate-gradient iterations of the last solve.
   int lastIterations() const { return last_iterations_; }
