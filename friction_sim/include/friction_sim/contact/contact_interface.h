@@ -127,7 +127,6 @@ class ContactInterface {
   double frictionDissipation() const { return dissipation_; }
   /// J, energy stored in the k_T anchor springs.
   double anchorEnergy(const Vector& u) const;
-  double tangentialStiffness() const { return k_t_; }
   const FrictionLaw& law() const { return *law_; }
   /// The interface nodes' x degrees of freedom: contiguous, dofs()[node] = dofs()[0] + node.
   const std::vector<int>& dofs() const { return dofs_; }

@@ -2,9 +2,10 @@
 // interface camera's frames and the load cells, as an experimentalist has them. An event starts at a
 // frame with a slipping node (SlipCriterion) after a frame with none and ends at the next frame with
 // none, once the frames show none for the criterion's quiet time; the slipped nodes are those seen
-// slipping in between. The simulator publishes a frame at every
-// step where a node begins slipping and where an event ends, so the camera misses no node's slip and no event, provided
-// that every frame arrives (a frame lost, or a bag recorded before that rule, can hide a short slip).
+// slipping in between. The simulator publishes a frame at every step where a node begins slipping and
+// where an event ends, so the camera misses no node's slip and no event, provided that every frame
+// arrives (a frame lost, or a bag whose simulator published frames at its rate alone, can hide a short
+// slip).
 #pragma once
 
 #include <deque>

@@ -112,8 +112,8 @@ class Simulation : public Dynamics {
   const Stage& stage() const { return stage_; }
   /// N, changes F_Z during the run; returns the refusal reason (checkNormalLoad) or empty.
   std::string setNormalLoad(double normal_force);
-  /// Why F_Z = `normal_force` (N) cannot be set now (empty if it can): it must be finite and > 0, and
-  /// the spring mattress's plate is placed once, when F_Z is first applied.
+  /// Why F_Z = `normal_force` (N) cannot be set now (empty if it can): it must be finite, > 0 and at most
+  /// largestNormalForce(scene), and the spring mattress's plate is placed once, when F_Z is first applied.
   std::string checkNormalLoad(double normal_force) const;
   /// Why `command` would be refused now (empty if acceptable): the stage's checks, or checkNormalLoad.
   std::string checkCommand(const TimedCommand& command) const;

@@ -57,8 +57,9 @@ class StaticSolver {
 
   /// Moves the free degrees of freedom of `u` to equilibrium with the stage at `stage_position` (m)
   /// and the extra forces `body_force` (N per dof; empty = none). The fixed ones stay as they are.
-  /// It stops once what is left, estimated from the last two corrections, is below 10⁻¹⁴ of the slider's
-  /// length. Returns the number of iterations, kMaxIterations + 1 if it did not converge.
+  /// It stops once what is left, estimated from the last two corrections, is below tolerance(): 10⁻¹⁴ of
+  /// as many node spacings as the model has nodes along x (about the slider's length). Returns the number
+  /// of iterations, kMaxIterations + 1 if it did not converge.
   int solve(Model& model, Vector& u, double stage_position, const Vector& body_force = Vector()) const;
 
   /// One iteration of solve(), without re-balancing a top load: for a state already near equilibrium,

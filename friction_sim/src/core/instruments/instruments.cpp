@@ -10,7 +10,7 @@ double EnergyBudget::relativeResidual() const {
   const double scale = std::max(
       {std::abs(work_in), std::abs(elastic - initial_elastic), kinetic, friction_dissipation, viscous_dissipation});
   // Where nothing moved (a stage held from the start) every term is round-off of the stored energy, and
-  // their ratio means nothing (it read −0.13).
+  // their ratio means nothing (it can read −0.13).
   if (!(scale > 1e-9 * std::abs(initial_elastic)) || scale == 0.0) return std::nan("");
   return residual() / scale;
 }

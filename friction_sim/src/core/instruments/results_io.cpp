@@ -1,6 +1,5 @@
 #include "friction_sim/instruments/results_io.h"
 
-#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>

@@ -3,11 +3,7 @@
 #include "run/acceleration_strips.h"
 #include "run/fast_forward.h"
 
-#include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 

@@ -11,7 +11,6 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
-#include <set>
 #include <sstream>
 #include <utility>
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <sstream>
 
-#include "scene/yaml_fields.h"
+#include "friction_sim/scene/config_error.h"
 
 namespace friction {
 
