@@ -140,6 +140,9 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"lattice: {nodes_x: 50}", "lattice.nodes_x/lattice.nodes_z: values 50, 31",
                     "sizes that fit 0.14 m x 0.075 m: nodes_x - 1 a multiple of 28, e.g. nodes_x: 57, nodes_z: 31"},
         InvalidCase{"instruments: {gauge_height: 0.1}", "instruments.gauge_height: value 0.1", "inside the slider"},
+        // Between the rows at 5 and 7.5 mm: the lattice's own rule (pushedRowsOf) finds none in it.
+        InvalidCase{"pusher: {band_min: 0.0051, band_max: 0.0074}", "pusher.band_max: value 0.0074",
+                    "contains at least one lattice row"},
         InvalidCase{"integrator: {time_step: 1.0e-5}", "integrator.time_step: value 1e-05",
                     "stability limit of this scene"},
         InvalidCase{"model: chain_1d\nchain: {tilt: -1.5}", "normal force of block", "w_i > 0"},

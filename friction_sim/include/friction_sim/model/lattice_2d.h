@@ -16,6 +16,9 @@ namespace friction {
 /// The row a pusher at `height` (m) above the interface acts on: the nearest of `rows` rows `spacing`
 /// (m) apart.
 int nearestRow(double height, double spacing, int rows);
+/// The rows of `rows` rows `spacing` (m) apart that the pusher acts on: those within its band, or the
+/// row nearest its height (nearestRow). Empty for a band that holds no row, which a valid scene has not.
+std::vector<int> pushedRowsOf(const PusherSpec& pusher, double spacing, int rows);
 
 class Lattice2D : public Model {
  public:

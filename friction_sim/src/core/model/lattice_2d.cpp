@@ -17,7 +17,6 @@ int nearestRow(double height, double spacing, int rows) {
   return std::clamp(static_cast<int>(std::lround(height / spacing)), 0, rows - 1);
 }
 
-namespace {
 std::vector<int> pushedRowsOf(const PusherSpec& pusher, double spacing, int nz) {
   std::vector<int> rows;
   if (pusher.hasBand()) {
@@ -30,7 +29,6 @@ std::vector<int> pushedRowsOf(const PusherSpec& pusher, double spacing, int nz) 
   }
   return rows;
 }
-}  // namespace
 
 Lattice2D::Lattice2D(const Scene& scene)
     : nx_(scene.lattice.nodes_x),

@@ -155,11 +155,9 @@ void checkPusher(Checker& check, const Scene& s) {
     check.within("pusher.band_min", s.pusher.band_min, 0.0, s.pusher.band_max, "0..pusher.band_max");
     check.within("pusher.band_max", s.pusher.band_max, std::max(s.pusher.band_min, 0.0), s.geometry.height,
                  "pusher.band_min..geometry.height");
-    if (lattice && s.lattice.nodes_z >= 2) {
-      const double spacing = s.geometry.height / (s.lattice.nodes_z - 1);
-      const bool holds_a_row =
-          std::floor(s.pusher.band_max / spacing + 1e-9) >= std::ceil(s.pusher.band_min / spacing - 1e-9);
-      check.require(holds_a_row, "pusher.band_max", s.pusher.band_max,
+    if (lattice && s.lattice.nodes_x >= 2 && s.lattice.nodes_z >= 2 && s.pusher.hasBand()) {
+      const double spacing = s.geometry.length / (s.lattice.nodes_x - 1);  // the lattice's own (Lattice2D)
+      check.require(!pushedRowsOf(s.pusher, spacing, s.lattice.nodes_z).empty(), "pusher.band_max", s.pusher.band_max,
                     "a band [band_min, band_max] that contains at least one lattice row");
     }
   }
