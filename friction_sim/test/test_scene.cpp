@@ -140,6 +140,8 @@ INSTANTIATE_TEST_SUITE_P(
         InvalidCase{"lattice: {nodes_x: 50}", "lattice.nodes_x/lattice.nodes_z: values 50, 31",
                     "sizes that fit 0.14 m x 0.075 m: nodes_x - 1 a multiple of 28, e.g. nodes_x: 57, nodes_z: 31"},
         InvalidCase{"instruments: {gauge_height: 0.1}", "instruments.gauge_height: value 0.1", "inside the slider"},
+        InvalidCase{"model: chain_1d\nload: {top: spring_mattress}", "load.top: spring_mattress is not allowed",
+                    "uniform (the chain has no top row)"},
         // Between the rows at 5 and 7.5 mm: the lattice's own rule (pushedRowsOf) finds none in it.
         InvalidCase{"pusher: {band_min: 0.0051, band_max: 0.0074}", "pusher.band_max: value 0.0074",
                     "contains at least one lattice row"},
@@ -268,9 +270,15 @@ TEST(InvalidScene, AScenePastTheMemoryLimitIsRefusedBeforeItIsBuilt) {
   setenv("FRICTION_MEMORY_LIMIT_MB", "100", 1);
   EXPECT_TRUE(problemsOf("lattice: {nodes_x: 57, nodes_z: 31}").empty());
   const auto problems = problemsOf("lattice: {nodes_x: 449, nodes_z: 241}\nintegrator: {time_step: 1.0e-8}");
+  // A limit that is not a number is refused by name (read as 0 it would refuse every scene).
+  setenv("FRICTION_MEMORY_LIMIT_MB", "2GB", 1);
+  const auto unread = problemsOf("lattice: {nodes_x: 57, nodes_z: 31}");
   unsetenv("FRICTION_MEMORY_LIMIT_MB");
   EXPECT_TRUE(mentions(problems, "lattice.nodes_x: value 449 is not allowed; allowed: at most 33333 nodes"))
       << problems[0];
+  ASSERT_EQ(unread.size(), 1u);
+  EXPECT_EQ(unread[0],
+            "FRICTION_MEMORY_LIMIT_MB (environment): value '2GB' is not allowed; allowed: a number of MB > 0");
 }
 
 TEST(InvalidScene, EveryProblemOfAFileIsListedAtOnce) {

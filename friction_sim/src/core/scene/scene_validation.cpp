@@ -87,8 +87,11 @@ void checkChain(Checker& check, const Scene& s) {
   check.require(s.chain.blocks >= 1, "chain.blocks", s.chain.blocks, "an integer >= 1");
   check.require(std::isfinite(s.chain.tilt), "chain.tilt", s.chain.tilt, "a finite number");
   check.within("chain.torque_share", s.chain.torque_share, 0.0, 1.0, "share of the moment h*F_X");
-  check.require(s.load.top == TopLoadKind::Uniform, "load.top", static_cast<double>(s.load.top),
-                "uniform (the chain has no top row)");
+  if (s.load.top != TopLoadKind::Uniform) {
+    check.problems.push_back(
+        "load.top: spring_mattress is not allowed on the chain; allowed: uniform (the chain has "
+        "no top row)");
+  }
   if (!s.chain.initial_shear.empty()) {
     check.require(static_cast<int>(s.chain.initial_shear.size()) == s.chain.blocks, "chain.initial_shear (length)",
                   s.chain.initial_shear.size(), "one force per block (chain.blocks) or an empty list");
@@ -282,9 +285,17 @@ double checkTimeStep(Checker& check, const Scene& s) {
   return limit;
 }
 
-/// bytes a run may use: half this machine's memory, or FRICTION_MEMORY_LIMIT_MB (MB) where it is set.
+constexpr const char* kMemoryLimitVariable = "FRICTION_MEMORY_LIMIT_MB";
+
+/// bytes a run may use: half this machine's memory, or kMemoryLimitVariable (MB) where it is set; NaN
+/// where that is not a number > 0.
 double memoryLimit() {
-  if (const char* set = std::getenv("FRICTION_MEMORY_LIMIT_MB")) return std::atof(set) * 1e6;
+  if (const char* set = std::getenv(kMemoryLimitVariable)) {
+    char* end = nullptr;
+    const double megabytes = std::strtod(set, &end);
+    const bool number = end != set && *end == '\0' && std::isfinite(megabytes) && megabytes > 0.0;
+    return number ? megabytes * 1e6 : std::nan("");
+  }
   return 0.5 * static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
 }
 
@@ -293,6 +304,11 @@ double memoryLimit() {
 /// from 225 x 121 to 10^6 nodes, taken as 3 kB; a chain block as 1 kB, measured 0.24 kB at 10^5).
 void checkMemory(Checker& check, const Scene& s) {
   const double limit = memoryLimit();
+  if (std::isnan(limit)) {
+    check.problems.push_back(std::string(kMemoryLimitVariable) + " (environment): value '" +
+                             std::getenv(kMemoryLimitVariable) + "' is not allowed; allowed: a number of MB > 0");
+    return;
+  }
   std::ostringstream limit_text;
   limit_text.precision(3);
   limit_text << limit / 1e9 << " GB (half this machine's memory; FRICTION_MEMORY_LIMIT_MB sets another)";
