@@ -51,8 +51,10 @@ TEST(LoadingProtocol, RampHoldDriveBecomesATimedSchedule) {
                                        0.0, 1000.0);
   ASSERT_EQ(driven.size(), 1u);
   EXPECT_EQ(driven[0].stage.mode, StageMode::Velocity);
-  EXPECT_FALSE(protocolEnded(protocol.end, 2, 0.0, 10.0));
-  EXPECT_TRUE(protocolEnded(protocol.end, 3, 0.0, 10.0));
+  // Its end, from a start at t = 5 s: the third global event ends it, whenever it comes.
+  const StopSpec stop = protocol.end.stopFrom(5.0);
+  EXPECT_FALSE(stopReached(stop, 2, 15.0, 0.0));
+  EXPECT_TRUE(stopReached(stop, 3, 15.0, 0.0));
 }
 
 /// Expects the protocol text refused with exactly `problems.size()` problems, each containing one of

@@ -88,10 +88,11 @@ void StageController::start(double time, double normal_force) {
   }
   // The simulator ends the run itself at the protocol's end, on the step where it is reached; where it
   // refuses that end, the watch in onStageState stops it.
+  const StopSpec run_end = protocol_.end.stopFrom(time);
   friction_msgs::SetRunEnd end;
-  end.request.global_events = static_cast<std::uint32_t>(protocol_.end.global_events);
-  end.request.time = time + protocol_.end.time;
-  end.request.stage_travel = protocol_.end.stage_travel;
+  end.request.global_events = static_cast<std::uint32_t>(run_end.global_events);
+  end.request.time = run_end.time;
+  end.request.stage_travel = run_end.stage_travel;
   simulator_ends_run_ = run_end_client_.call(end) && end.response.accepted;
   if (!simulator_ends_run_) {
     ROS_WARN_STREAM("stage controller: the simulator did not take the protocol's end ("
@@ -129,7 +130,10 @@ void StageController::onStageState(const friction_msgs::StageState::ConstPtr& ms
   resets_seen_ = msg->resets;
   if (!started_) start(time, msg->normal_force);
   if (failed_) return;
-  if (ended_ || !protocolEnded(protocol_.end, msg->global_events, msg->travel, time - start_time_)) return;
+  if (ended_ ||
+      !stopReached(protocol_.end.stopFrom(start_time_), static_cast<int>(msg->global_events), time, msg->travel)) {
+    return;
+  }
   ended_ = true;
   ROS_INFO_STREAM("stage controller: protocol ended at t = "
                   << time << " s after " << msg->global_events << " global events"

@@ -174,7 +174,7 @@ int run(int argc, char** argv) {
   friction::LoadingProtocol protocol;
   if (!args.protocol_path.empty()) {
     protocol = friction::loadProtocol(args.protocol_path);
-    scene.stop = {protocol.end.global_events, protocol.end.time, protocol.end.stage_travel};
+    scene.stop = protocol.end.stopFrom(0.0);
   }
   friction::RunOptions options;
   // A recorded time is its step's rounded to whole nanoseconds: due within half of one. A protocol's

@@ -180,7 +180,7 @@ class Simulation : public Dynamics {
   void checkStop();
   /// Composes the stop reason; kept out of checkStop, whose every-step test it would otherwise slow
   /// with a string stream's set-up.
-  void recordStopReason(bool enough_events);
+  void recordStopReason();
 
   Scene scene_;
   std::unique_ptr<Model> model_;

@@ -36,6 +36,8 @@ struct ProtocolEnd {
   int global_events = 0;  ///< end after this many global slip events (0 = not this condition)
   double stage_travel = std::numeric_limits<double>::infinity();  ///< m
   double time = std::numeric_limits<double>::infinity();          ///< s since the protocol started
+  /// The run's stop condition for a protocol started at `start_time` (s of simulated time).
+  StopSpec stopFrom(double start_time) const { return {global_events, start_time + time, stage_travel}; }
 };
 
 struct LoadingProtocol {
@@ -101,8 +103,5 @@ std::vector<TimedCommand> protocolCommands(const LoadingProtocol& protocol, doub
 /// Throws ConfigError listing every step of `protocol` (read from `path`) that `check` refuses what it acts
 /// with (stepCommand), before anything runs.
 void checkProtocolSteps(const LoadingProtocol& protocol, const std::string& path, const CommandCheck& check);
-
-/// True once an end condition of the protocol holds.
-bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time);
 
 }  // namespace friction

@@ -168,6 +168,12 @@ inline bool endsTheRun(const StopSpec& stop) {
   return stop.global_events != 0 || stop.time < std::numeric_limits<double>::infinity() ||
          stop.stage_travel < std::numeric_limits<double>::infinity();
 }
+/// Whether a run under `stop` has ended: `global_events` global slip events ended, the clock at `time`
+/// (s), the stage moved by `stage_travel` (m). The simulator's rule, and a controller's for its protocol.
+inline bool stopReached(const StopSpec& stop, int global_events, double time, double stage_travel) {
+  return (stop.global_events > 0 && global_events >= stop.global_events) || !(time < stop.time) ||
+         !(stage_travel < stop.stage_travel);
+}
 /// The refusal of a stop condition that does not (scenes and set_run_end alike).
 constexpr const char* kNoEndProblem =
     "no condition, so the run would never end; give global_events, time or stage_travel";

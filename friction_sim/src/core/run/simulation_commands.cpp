@@ -10,15 +10,12 @@ namespace friction {
 
 void Simulation::checkStop() {
   if (finished()) return;  // the first reason stands while a caller steps on past it
-  const bool enough_events = scene_.stop.global_events > 0 && globalEventCount() >= scene_.stop.global_events;
-  if (enough_events || !(time_ < scene_.stop.time) || !(stage_.travel() < scene_.stop.stage_travel)) {
-    recordStopReason(enough_events);
-  }
+  if (stopReached(scene_.stop, globalEventCount(), time_, stage_.travel())) recordStopReason();
 }
 
-[[gnu::cold]] void Simulation::recordStopReason(bool enough_events) {
+[[gnu::cold]] void Simulation::recordStopReason() {
   std::ostringstream reason;
-  if (enough_events) {
+  if (scene_.stop.global_events > 0 && globalEventCount() >= scene_.stop.global_events) {
     reason << "reached " << globalEventCount() << " global slip event(s)";
   } else if (time_ >= scene_.stop.time) {
     reason << "reached the time limit of " << scene_.stop.time << " s";

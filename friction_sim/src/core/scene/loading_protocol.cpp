@@ -106,7 +106,7 @@ void checkProtocolValues(const LoadingProtocol& protocol, const ProtocolReading&
   if (!(protocol.end.stage_travel > 0.0)) problem("end.stage_travel", protocol.end.stage_travel, "a travel > 0 m");
   if (!(protocol.end.time > 0.0)) problem("end.time", protocol.end.time, "a time > 0 s");
   if (protocol.ramp_commands < 1) problem("ramp_commands", protocol.ramp_commands, "an integer >= 1");
-  if (!endsTheRun(StopSpec{protocol.end.global_events, protocol.end.time, protocol.end.stage_travel})) {
+  if (!endsTheRun(protocol.end.stopFrom(0.0))) {
     problems.push_back(std::string("end: ") + kNoEndProblem);
   }
 }
@@ -353,11 +353,6 @@ std::vector<TimedCommand> loadCommandTable(const std::string& path, const Comman
   const std::string text = readTextFile(path, problems);
   if (!problems.empty()) throw ConfigError("command table", problems);
   return parseCommandTable(text, path, check);
-}
-
-bool protocolEnded(const ProtocolEnd& end, int global_events, double stage_travel, double elapsed_time) {
-  return (end.global_events > 0 && global_events >= end.global_events) || stage_travel >= end.stage_travel ||
-         elapsed_time >= end.time;
 }
 
 std::vector<TimedCommand> protocolCommands(const LoadingProtocol& protocol, double start_normal_force) {
