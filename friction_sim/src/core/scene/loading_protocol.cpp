@@ -199,7 +199,16 @@ double stampSeconds(double seconds) {
 
 namespace {
 
-constexpr const char* kCommandTableHeader = "time_s,command,speed_m_s,target_m,normal_force_N";
+/// The command table's columns in order, as rig_report writes them.
+constexpr std::array<const char*, 5> kCommandTableColumns{"time_s", "command", "speed_m_s", "target_m",
+                                                          "normal_force_N"};
+
+/// The columns' names joined by `separator`.
+std::string commandTableColumns(const std::string& separator) {
+  std::string joined;
+  for (const char* column : kCommandTableColumns) joined += (joined.empty() ? "" : separator) + column;
+  return joined;
+}
 
 /// A number that fills all of `text` (C syntax, inf and nan included).
 bool readNumber(const std::string& text, double& value) {
@@ -246,8 +255,7 @@ bool readCommandTime(const std::string& cell, const TimedCommand* before, TimedC
 /// each problem; false if the command is unknown.
 bool readCommandFields(const std::vector<std::string>& cells, TimedCommand& command,
                        const std::function<void(const std::string&)>& problem) {
-  // The fields each command takes, by column (speed, target, normal_force).
-  static const std::array<const char*, 3> kColumns{"speed_m_s", "target_m", "normal_force_N"};
+  // The fields each command takes, by column from the third (speed, target, normal_force).
   std::array<bool, 3> takes{};
   const std::string& name = cells[1];
   if (name == "velocity") {
@@ -266,12 +274,13 @@ bool readCommandFields(const std::vector<std::string>& cells, TimedCommand& comm
     return false;
   }
   std::array<double*, 3> fields{&command.stage.speed, &command.stage.target, &command.normal_force};
-  for (std::size_t column = 0; column < kColumns.size(); ++column) {
-    const std::string& cell = cells[column + 2];
-    if (!takes[column]) {
-      if (!cell.empty()) problem(name + " takes no " + kColumns[column] + ", got '" + cell + "'; leave it empty");
-    } else if (!readNumber(cell, *fields[column])) {
-      problem(name + " needs " + kColumns[column] + " as a number, got '" + cell + "'");
+  for (std::size_t field = 0; field < fields.size(); ++field) {
+    const std::string& cell = cells[field + 2];
+    const std::string column = kCommandTableColumns[field + 2];
+    if (!takes[field]) {
+      if (!cell.empty()) problem(name + " takes no " + column + ", got '" + cell + "'; leave it empty");
+    } else if (!readNumber(cell, *fields[field])) {
+      problem(name + " needs " + column + " as a number, got '" + cell + "'");
     }
   }
   return true;
@@ -283,8 +292,8 @@ bool readCommandFields(const std::vector<std::string>& cells, TimedCommand& comm
 bool readCommandRow(const std::string& line, const TimedCommand* before, const CommandCheck& check,
                     const std::function<void(const std::string&)>& problem, TimedCommand& command) {
   const std::vector<std::string> cells = splitCsvLine(line);
-  if (cells.size() != 5) {
-    problem("5 fields expected (time_s, command, speed_m_s, target_m, normal_force_N), got " +
+  if (cells.size() != kCommandTableColumns.size()) {
+    problem(std::to_string(kCommandTableColumns.size()) + " fields expected (" + commandTableColumns(", ") + "), got " +
             std::to_string(cells.size()) + " in '" + line + "'");
     return false;
   }
@@ -331,8 +340,9 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
     return true;
   };
   const bool header_seen = next_line();
-  if (header_seen && line != kCommandTableHeader) {
-    problem("the header must be '" + std::string(kCommandTableHeader) + "', got '" + line + "'");
+  const std::string header = commandTableColumns(",");
+  if (header_seen && line != header) {
+    problem("the header must be '" + header + "', got '" + line + "'");
   }
   while (next_line()) {
     if (line.empty()) continue;
@@ -342,8 +352,7 @@ std::vector<TimedCommand> parseCommandTable(const std::string& csv_text, const s
     }
   }
   if (!header_seen)
-    problems.push_back(where_prefix + "1: empty; a command table starts with its header '" +
-                       std::string(kCommandTableHeader) + "'");
+    problems.push_back(where_prefix + "1: empty; a command table starts with its header '" + header + "'");
   if (!problems.empty()) throw ConfigError("command table", problems);
   return commands;
 }
