@@ -82,6 +82,19 @@ TEST(LoadingProtocol, BadProtocolListsEveryProblem) {
        "steps[2].action: value 'jump'", "end.cycles: unknown key", "end.global_events: value -1"});
 }
 
+TEST(LoadingProtocol, AFieldItsStepDoesNotActWithIsRefusedNamingWhatItTakes) {
+  // A writer who gives a normal_load a duration, or a hold a speed, expects it to act; it would not.
+  expectProtocolRefused(
+      "steps:\n"
+      "  - {action: normal_load, normal_force: 2000, duration: 0.1}\n"
+      "  - {action: hold, speed: 4.0e-4, duration: 0.1}\n"
+      "  - {action: drive, speed: 4.0e-4, target: 0.01, duration: .inf}\n"
+      "end: {global_events: 1}\n",
+      {"steps[0].duration: unknown key; allowed keys here: action, normal_force, ramp_time",
+       "steps[1].speed: unknown key; allowed keys here: action, duration",
+       "steps[2].target: unknown key; allowed keys here: action, duration, speed"});
+}
+
 TEST(LoadingProtocol, WhatAStepActsWithAndAnEndMustBeGiven) {
   // A move_to without its target drove the stage back to 0, and a protocol without an end ran (and
   // recorded) until stopped. Each missing field is named once, not

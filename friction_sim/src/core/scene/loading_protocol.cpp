@@ -1,8 +1,10 @@
 #include "friction_sim/scene/loading_protocol.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <initializer_list>
 #include <set>
 #include <sstream>
 #include <string>
@@ -53,11 +55,21 @@ ProtocolReading readProtocolFields(const YAML::Node& root, LoadingProtocol& prot
       }
       if (step.action == ProtocolAction::MoveTo) require("target", "the stage position to move to, m");
     }
-    reader.field("normal_force", step.normal_force);
-    reader.field("ramp_time", step.ramp_time);
-    reader.field("speed", step.speed);
-    reader.field("target", step.target);
-    reader.field("duration", step.duration);
+    // Only the fields its action acts with: another (a duration on normal_load, a speed on hold) would
+    // be read and ignored, while its writer expects it to act. Past a refused action, all of them.
+    const bool known = !reading.action_refused.back();
+    auto uses = [&](std::initializer_list<ProtocolAction> actions) {
+      return !known || std::find(actions.begin(), actions.end(), step.action) != actions.end();
+    };
+    if (uses({ProtocolAction::NormalLoad})) {
+      reader.field("normal_force", step.normal_force);
+      reader.field("ramp_time", step.ramp_time);
+    }
+    if (uses({ProtocolAction::Drive, ProtocolAction::MoveTo})) reader.field("speed", step.speed);
+    if (uses({ProtocolAction::MoveTo})) reader.field("target", step.target);
+    if (uses({ProtocolAction::Hold, ProtocolAction::Drive, ProtocolAction::MoveTo})) {
+      reader.field("duration", step.duration);
+    }
   });
   reader.section("end", [&] {
     reader.field("global_events", protocol.end.global_events);
