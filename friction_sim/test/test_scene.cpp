@@ -87,6 +87,9 @@ TEST(SceneFiles, WrittenSceneReadsBackIdentically) {
   const Scene exact = parseScene(sceneToYaml(scene));
   EXPECT_EQ(exact.pusher.height, scene.pusher.height);
   EXPECT_EQ(exact.stop.time, scene.stop.time);
+  // A NaN in a field the lattice's checks leave alone (the chain's tilt) is written as YAML reads it.
+  scene.chain.tilt = std::nan("");
+  EXPECT_TRUE(std::isnan(parseScene(sceneToYaml(scene)).chain.tilt));
   EXPECT_EQ(exact.material.youngs_modulus, 3.0e9);
 }
 
@@ -279,6 +282,14 @@ TEST(InvalidScene, AScenePastTheMemoryLimitIsRefusedBeforeItIsBuilt) {
   ASSERT_EQ(unread.size(), 1u);
   EXPECT_EQ(unread[0],
             "FRICTION_MEMORY_LIMIT_MB (environment): value '2GB' is not allowed; allowed: a number of MB > 0");
+}
+
+TEST(InvalidScene, APusherBandOfNaNIsRefusedNotTakenForNone) {
+  const auto problems = problemsOf("pusher: {band_min: .nan, band_max: .nan}");
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[0].find("pusher.band_min: value nan is not allowed"), 0u) << problems[0];
+  EXPECT_EQ(problems[1],
+            "pusher.band_max: value nan is not allowed; allowed: [0, 0.075] (pusher.band_min..geometry.height)");
 }
 
 TEST(InvalidScene, EveryProblemOfAFileIsListedAtOnce) {

@@ -181,6 +181,8 @@ class YamlWriter {
   void write(double value) {
     if (std::isinf(value)) {
       out_ << (value > 0 ? ".inf" : "-.inf");
+    } else if (std::isnan(value)) {
+      out_ << ".nan";  // YAML's, which the reader takes (a field that validation leaves unchecked may hold it)
     } else {
       out_ << formatNumber(value);
     }

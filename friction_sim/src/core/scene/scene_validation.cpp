@@ -153,10 +153,11 @@ void checkPusher(Checker& check, const Scene& s) {
   const bool lattice = s.model == ModelKind::Lattice2D;
   check.positive("pusher.stiffness", s.pusher.stiffness);
   check.within("pusher.height", s.pusher.height, 0.0, s.geometry.height, "inside the slider, 0..geometry.height");
-  if (s.pusher.band_min >= 0.0 || s.pusher.band_max >= 0.0) {
+  // A band is given unless both ends are negative (the default): NaN counts as given, and is refused.
+  if (!(s.pusher.band_min < 0.0) || !(s.pusher.band_max < 0.0)) {
     check.require(lattice, "pusher.band_min", s.pusher.band_min, "a band only on the 2D lattice");
     check.within("pusher.band_min", s.pusher.band_min, 0.0, s.pusher.band_max, "0..pusher.band_max");
-    check.within("pusher.band_max", s.pusher.band_max, std::max(s.pusher.band_min, 0.0), s.geometry.height,
+    check.within("pusher.band_max", s.pusher.band_max, std::fmax(s.pusher.band_min, 0.0), s.geometry.height,
                  "pusher.band_min..geometry.height");
     if (lattice && s.lattice.nodes_x >= 2 && s.lattice.nodes_z >= 2 && s.pusher.hasBand()) {
       const double spacing = s.geometry.length / (s.lattice.nodes_x - 1);  // the lattice's own (Lattice2D)
