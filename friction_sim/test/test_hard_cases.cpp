@@ -175,6 +175,12 @@ TEST(HardCases, SmallestSystems) {
   Simulation two_blocks(twoBlockChain());
   expectSound(two_blocks, 1e-4);
   EXPECT_EQ(two_blocks.globalEventCount(), 3);
+  // While both blocks stick, the pusher's force rests on the pushed block alone: it slips first, at
+  // F_X = µ_s·F_Z/2 (no torque term: each block carries half of F_Z).
+  const Scene& scene = two_blocks.scene();
+  const SlipEvent& first = two_blocks.events().front();
+  EXPECT_NEAR(first.onset_shear_force, scene.friction.static_coefficient * scene.load.normal_force / 2.0,
+              1e-9 * scene.load.normal_force);
   Simulation four_nodes(fourNodeLattice());
   expectSound(four_nodes, 1e-4);
   EXPECT_EQ(four_nodes.globalEventCount(), 2);
