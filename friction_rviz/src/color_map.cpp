@@ -70,6 +70,7 @@ bool signedField(Field field) {
 std::vector<double> fieldValues(Field field, const std::vector<float>& sigma_xx, const std::vector<float>& sigma_zz,
                                 const std::vector<float>& tau_xz, const std::vector<float>& speed) {
   const std::size_t n = field == Field::Speed ? speed.size() : sigma_zz.size();
+  if (field != Field::Speed && (sigma_xx.size() != n || tau_xz.size() != n)) return {};
   std::vector<double> out(n);
   for (std::size_t i = 0; i < n; ++i) {
     // In double: the squares of stresses of megapascals lose digits in float.

@@ -17,12 +17,13 @@
 
 namespace friction_rviz {
 
-InterfaceDisplay::InterfaceDisplay() : history_(300) {
-  rows_ =
-      new rviz::IntProperty("History", 300, "Frames kept in the strip (older ones scroll out).", this, SLOT(resize()));
+InterfaceDisplay::InterfaceDisplay() : history_(kDefaultRows) {
+  rows_ = new rviz::IntProperty("History", kDefaultRows, "Frames kept in the strip (older ones scroll out).", this,
+                                SLOT(startHistoryOver()));
   rows_->setMin(2);
   rows_->setMax(5000);
-  field_ = new rviz::EnumProperty("Field", "slip velocity", "What the strip shows.", this, SLOT(markDirty()));
+  // Another field starts the strip over: its rows would mix m/s with m or µ_s under one colour range.
+  field_ = new rviz::EnumProperty("Field", "slip velocity", "What the strip shows.", this, SLOT(startHistoryOver()));
   field_->addOption("slip velocity", 0);
   field_->addOption("slip", 1);
   field_->addOption("static friction", 2);
@@ -53,7 +54,7 @@ void InterfaceDisplay::reset() {
   if (strip_) strip_->clear();
 }
 
-void InterfaceDisplay::resize() {
+void InterfaceDisplay::startHistoryOver() {
   history_ = SpaceTimeHistory(static_cast<std::size_t>(rows_->getInt()));
   dirty_ = true;
 }

@@ -35,7 +35,8 @@ class InterfaceDisplay : public rviz::MessageFilterDisplay<friction_msgs::Interf
   void update(float wall_dt, float ros_dt) override;
 
  private Q_SLOTS:
-  void resize();
+  /// The strip emptied, with as many rows as "History" says.
+  void startHistoryOver();
   void markDirty();
 
  private:
@@ -49,6 +50,7 @@ class InterfaceDisplay : public rviz::MessageFilterDisplay<friction_msgs::Interf
   rviz::FloatProperty* height_;
   rviz::FloatProperty* offset_;
   rviz::FloatProperty* scale_;
+  static constexpr int kDefaultRows = 300;  ///< frames the strip keeps unless "History" says otherwise
   SpaceTimeHistory history_;
   Ogre::ManualObject* strip_ = nullptr;
   bool dirty_ = false;

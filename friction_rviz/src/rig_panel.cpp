@@ -128,7 +128,12 @@ RigPanel::RigPanel(QWidget* parent) : rviz::Panel(parent) {
   precursor_plot_ = new PlotWidget("F_X / F_Z", "L_p / L");
   layout->addWidget(loading_plot_);
   layout->addWidget(precursor_plot_);
-  state_label_ = new QLabel("stage: waiting for /rig/stage_state");
+  state_label_ = new QLabel;
+  // As wide as a state's line from the start: the dock, sized by it, must not change width when the first
+  // state replaces the shorter "waiting" line (the 3D view beside it would move).
+  state_label_->setMinimumWidth(state_label_->fontMetrics().horizontalAdvance(
+      "stage: t = 0.8370 s, velocity, X_s = 0.3348 mm, V = 0.400 mm/s, F_X = 261.1 N, F_Z = 1920.0 N, "
+      "global events 4"));
   layout->addWidget(state_label_);
   auto* controls = new QGridLayout;
   speed_ = new QDoubleSpinBox;
@@ -172,6 +177,14 @@ RigPanel::RigPanel(QWidget* parent) : rviz::Panel(parent) {
 
 void RigPanel::connectToRig() {
   const std::string ns = namespace_edit_->text().toStdString();
+  // A typo typed or loaded from a config ("my rig") would throw out of this slot and end rviz.
+  std::string invalid;
+  if (!ros::names::validate(ns, invalid)) {
+    reply_label_->setText(QString::fromStdString("namespace '" + ns + "' is not a valid ROS name (" + invalid +
+                                                 "); still showing " + connected_namespace_));
+    return;
+  }
+  connected_namespace_ = ros::names::resolve(ns);
   ros::NodeHandle rig(ns);
   load_cells_sub_ = rig.subscribe("load_cells", 100, &RigPanel::onLoadCells, this);
   events_sub_ = rig.subscribe("slip_events", 100, &RigPanel::onEvent, this);
@@ -180,6 +193,7 @@ void RigPanel::connectToRig() {
   pause_client_ = rig.serviceClient<std_srvs::SetBool>("pause");
   shear_.clear();
   events_.clear();
+  last_state_.reset();
   Q_EMIT configChanged();
 }
 
@@ -219,17 +233,23 @@ void RigPanel::refresh() {
                               events(EventKind::BackSlip, QColor(30, 150, 60), true, "back-slip (against x)"),
                               events(EventKind::AfterGlobal, QColor(150, 150, 150), false, "after a global slip"),
                               events(EventKind::Global, QColor(210, 30, 30), false, "global event")});
+  if (!last_state_) {
+    state_label_->setText(
+        QString::fromStdString("stage: waiting for " + ros::names::append(connected_namespace_, "stage_state")));
+    return;
+  }
+  const friction_msgs::StageState& state = *last_state_;
   const char* modes[] = {"velocity", "hold", "position"};
   state_label_->setText(QString("stage: t = %1 s, %2, X_s = %3 mm, V = %4 mm/s, F_X = %5 N, F_Z = %6 N, "
                                 "global events %7%8")
-                            .arg(last_state_.header.stamp.toSec(), 0, 'f', 4)
-                            .arg(modes[std::min<int>(last_state_.mode, 2)])
-                            .arg(last_state_.position * 1e3, 0, 'f', 4)
-                            .arg(last_state_.velocity * 1e3, 0, 'f', 3)
-                            .arg(last_state_.shear_force, 0, 'f', 1)
-                            .arg(last_state_.normal_force, 0, 'f', 1)
-                            .arg(last_state_.global_events)
-                            .arg(last_state_.paused ? " (paused)" : ""));
+                            .arg(state.header.stamp.toSec(), 0, 'f', 4)
+                            .arg(modes[std::min<int>(state.mode, 2)])
+                            .arg(state.position * 1e3, 0, 'f', 4)
+                            .arg(state.velocity * 1e3, 0, 'f', 3)
+                            .arg(state.shear_force, 0, 'f', 1)
+                            .arg(state.normal_force, 0, 'f', 1)
+                            .arg(state.global_events)
+                            .arg(state.paused ? " (paused)" : ""));
 }
 
 void RigPanel::send(const friction_msgs::StageCommand& command) {
@@ -247,7 +267,7 @@ void RigPanel::setNormalLoad() { send(normalLoadCommand(normal_load_->value()));
 
 void RigPanel::togglePause() {
   std_srvs::SetBool call;
-  call.request.data = !last_state_.paused;
+  call.request.data = !(last_state_ && last_state_->paused);  // unknown yet: pause
   const bool ok = pause_client_.call(call);
   reply_label_->setText(ok ? "reply: " + QString::fromStdString(call.response.message) : "reply: no reply from pause");
 }

@@ -18,6 +18,8 @@
 #endif
 
 #include <QWidget>
+#include <optional>
+#include <string>
 
 class QDoubleSpinBox;
 class QLabel;
@@ -78,7 +80,8 @@ class RigPanel : public rviz::Panel {
   PlotWidget *loading_plot_, *precursor_plot_;
   SeriesHistory shear_{20000};
   PrecursorScatter events_;
-  friction_msgs::StageState last_state_;
+  std::optional<friction_msgs::StageState> last_state_;  ///< none yet from the rig connected to
+  std::string connected_namespace_;                      ///< resolved, of the rig the panel shows
 };
 
 }  // namespace friction_rviz

@@ -104,7 +104,10 @@ void SliderDisplay::redraw() {
   const auto& m = *latest_;
   const int nx = static_cast<int>(m.nodes_x), nz = static_cast<int>(m.nodes_z);
   const std::size_t n = m.x.size();
-  if (nx < 1 || nz < 1 || n != static_cast<std::size_t>(nx) * nz || m.z.size() != n) {
+  // Per-node arrays may be left empty (drawn grey) but not of another length: they index one another.
+  const auto fits = [n](const std::vector<float>& values) { return values.empty() || values.size() == n; };
+  if (nx < 1 || nz < 1 || n != static_cast<std::size_t>(nx) * nz || m.z.size() != n || !fits(m.sigma_xx) ||
+      !fits(m.sigma_zz) || !fits(m.tau_xz) || !fits(m.speed)) {
     setStatus(rviz::StatusProperty::Error, "Snapshot", "node arrays do not match nodes_x * nodes_z");
     ROS_ERROR_THROTTLE(5.0, "friction_rviz Slider: node arrays do not match nodes_x * nodes_z");
     return;
@@ -112,8 +115,18 @@ void SliderDisplay::redraw() {
   setStatus(rviz::StatusProperty::Ok, "Snapshot", QString("%1 x %2 nodes").arg(nx).arg(nz));
   const Field field = static_cast<Field>(field_->getOptionInt());
   const std::vector<double> values = fieldValues(field, m.sigma_xx, m.sigma_zz, m.tau_xz, m.speed);
-  const Range range = auto_range_->getBool() ? autoRange(values, signedField(field))
-                                             : Range{range_min_->getFloat(), range_max_->getFloat()};
+  Range range = autoRange(values, signedField(field));
+  const Range manual{range_min_->getFloat(), range_max_->getFloat()};
+  const bool manual_refused = !auto_range_->getBool() && !(manual.max > manual.min);
+  if (manual_refused) {
+    setStatus(rviz::StatusProperty::Error, "Range",
+              QString("Range max (%1) must exceed Range min (%2): the automatic range is drawn")
+                  .arg(manual.max)
+                  .arg(manual.min));
+  } else {
+    deleteStatus("Range");
+    if (!auto_range_->getBool()) range = manual;
+  }
   const double gain = magnification_->getFloat();
   const double l = m.spacing;
   // Drawn position: rest position plus the magnified deformation. The slider's mean x displacement

@@ -58,6 +58,9 @@ TEST(ColorMap, FieldValuesFromNodeStresses) {
   EXPECT_NEAR(mises[1], 1e6, 1e-6);  // equibiaxial: sqrt(1 - 1 + 1)·σ
   const auto speeds = fieldValues(Field::Speed, sxx, szz, txz, speed);
   EXPECT_EQ(speeds, std::vector<double>(speed.begin(), speed.end()));
+  // Stress arrays of different lengths (a foreign or truncated snapshot) give none, not a read past one.
+  EXPECT_TRUE(fieldValues(Field::VonMises, {0.0f}, szz, txz, speed).empty());
+  EXPECT_EQ(fieldValues(Field::Speed, {0.0f}, szz, txz, speed).size(), 2u);
   EXPECT_TRUE(signedField(Field::TauXZ));
   EXPECT_FALSE(signedField(Field::Speed));
 }

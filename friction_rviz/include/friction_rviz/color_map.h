@@ -36,7 +36,8 @@ std::string fieldLabel(Field field);  ///< with its unit
 bool signedField(Field field);
 
 /// Per-node value of `field` from node stresses (Pa) and speeds (m/s): τ/σ is τ_xz/(−σ_zz) (the
-/// shear-to-compression ratio, NaN where the node is not compressed); von Mises in plane stress.
+/// shear-to-compression ratio, NaN where the node is not compressed); von Mises in plane stress. None
+/// where the arrays the field reads differ in length.
 std::vector<double> fieldValues(Field field, const std::vector<float>& sigma_xx, const std::vector<float>& sigma_zz,
                                 const std::vector<float>& tau_xz, const std::vector<float>& speed);
 
