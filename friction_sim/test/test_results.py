@@ -171,7 +171,7 @@ class ResultsTest(unittest.TestCase):
         order.event(event_ending(1, 1.9))
         self.assertEqual(handed, [0, 1])
 
-    def test_frames_and_events_fed_from_two_threads_hand_each_event_on_once(self):
+    def test_frames_and_events_fed_from_two_threads_hand_each_event_on_once_in_order(self):
         # As rospy feeds them: one thread per topic.
         order, handed = handed_in_order()
         events = [event_ending(k, 1e-3 * k) for k in range(2000)]
@@ -183,7 +183,38 @@ class ResultsTest(unittest.TestCase):
         for thread in threads:
             thread.join()
         order.flush()
-        self.assertEqual(sorted(handed), list(range(2000)))
+        self.assertEqual(handed, list(range(2000)))
+
+    def test_a_table_with_a_short_row_is_refused_naming_its_line(self):
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "events.csv")
+            with open(path, "w") as handle:
+                handle.write("index,onset_time_s\n0,0.1\n1\n")
+            with self.assertRaisesRegex(ValueError, "events.csv line 3: 1 cells, the header has 2"):
+                results.read_csv(path)
+
+    def test_an_event_released_while_another_is_handed_on_waits_for_it(self):
+        # One thread is still handing on event 0 when another releases event 1: 1 must come second.
+        handed, in_first, go_on = [], threading.Event(), threading.Event()
+
+        def on_event(event):
+            if event.index == 0:
+                in_first.set()
+                go_on.wait(10)
+            handed.append(event.index)
+
+        order = results.EventsAfterFrames(on_event)
+        order.frame(frame_at(1.0))
+        first = threading.Thread(target=order.event, args=(event_ending(0, 0.5),))
+        first.start()
+        self.assertTrue(in_first.wait(10))
+        second = threading.Thread(target=order.event, args=(event_ending(1, 0.6),))
+        second.start()
+        second.join(0.5)  # time for it to hand on, were it not to wait
+        go_on.set()
+        first.join()
+        second.join()
+        self.assertEqual(handed, [0, 1])
 
     def test_events_held_at_a_reset_or_the_runs_end_are_handed_on(self):
         order, handed = handed_in_order()

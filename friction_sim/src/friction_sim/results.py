@@ -99,6 +99,10 @@ def read_csv(path):
     if not rows:
         raise ValueError("%s is empty: a results table has a header row" % path)
     header, body = rows[0], rows[1:]
+    for line, row in enumerate(body, start=2):
+        if len(row) != len(header):
+            raise ValueError("%s line %d: %d cells, the header has %d (a run ended while writing it?)"
+                             % (path, line, len(row), len(header)))
     return Table(collections.OrderedDict((name, _column(name, [row[i] for row in body]))
                                          for i, name in enumerate(header)))
 
@@ -293,8 +297,8 @@ class EventsAfterFrames:
 
     At the end of a run (no frame follows an unfinished event), `flush()` hands on what is held. A stamp
     that goes back (a reset, a looped bag) hands on what is held and starts over. Safe to feed from two
-    threads; `on_event` runs on the thread that fed the frame or the event that released it, outside the
-    lock, in the order the events arrived."""
+    threads; `on_event` runs on the thread that fed the frame or the event that released it, in the order
+    the events arrived, one at a time (it must not feed this object)."""
 
     def __init__(self, on_event):
         self._on_event = on_event
@@ -302,27 +306,41 @@ class EventsAfterFrames:
         self._latest_frame = None
         # rospy calls each topic's callbacks on a thread of its own: frames and events come in together.
         self._lock = threading.Lock()
+        # Taken before _lock is let go and held while handing on: a batch released later waits for the
+        # one released before it, which another thread may still be handing on.
+        self._handing_on = threading.Lock()
 
     def frame(self, frame):
-        with self._lock:
-            stamp = frame.header.stamp
+        def release():
             ready = []
-            if self._latest_frame is not None and stamp < self._latest_frame:
+            if self._latest_frame is not None and frame.header.stamp < self._latest_frame:
                 ready, self._held = self._held, []
-            self._latest_frame = stamp
-            ready += self._take_ready()
-        self._hand_on(ready)
+            self._latest_frame = frame.header.stamp
+            return ready + self._take_ready()
+        self._release(release)
 
     def event(self, event):
-        with self._lock:
+        def release():
             self._held.append(event)
-            ready = self._take_ready()
-        self._hand_on(ready)
+            return self._take_ready()
+        self._release(release)
 
     def flush(self):
-        with self._lock:
+        def release():
             ready, self._held = self._held, []
-        self._hand_on(ready)
+            return ready
+        self._release(release)
+
+    def _release(self, take):
+        """Hands on what `take` removes from the held events, after every batch released before it."""
+        with self._lock:
+            ready = take()
+            self._handing_on.acquire()
+        try:
+            for event in ready:
+                self._on_event(event)
+        finally:
+            self._handing_on.release()
 
     def _take_ready(self):
         """Removes and returns the held events whose closing frame has come (call with the lock held)."""
@@ -331,7 +349,3 @@ class EventsAfterFrames:
         ready = [e for e in self._held if e.header.stamp <= self._latest_frame]
         self._held = [e for e in self._held if e.header.stamp > self._latest_frame]
         return ready
-
-    def _hand_on(self, events):
-        for event in events:
-            self._on_event(event)
