@@ -52,6 +52,22 @@ def load(path):
     if unknown or "base" not in spec:
         sys.exit("sweep: %s: keys allowed are base (required), protocol, set, vary, cases; got %s" % (
             path, sorted(spec)))
+    problems = ["%s: expected a path, got %r" % (key, spec[key]) for key in ("base", "protocol")
+                if key in spec and not isinstance(spec[key], str)]
+    if not isinstance(spec.get("set") or {}, dict):
+        problems.append("set: expected a mapping of scene fields to values, got %r" % spec["set"])
+    vary = spec.get("vary") or {}
+    if not isinstance(vary, dict):
+        problems.append("vary: expected a mapping of scene fields to lists of values, got %r" % vary)
+    else:
+        # A bare value would fail later; a string would be varied letter by letter.
+        problems += ["vary.%s: expected a non-empty list of values, got %r" % (name, values)
+                     for name, values in vary.items() if not isinstance(values, list) or not values]
+    cases = spec.get("cases") or []
+    if not isinstance(cases, list) or not all(isinstance(case, dict) for case in cases):
+        problems.append("cases: expected a list of mappings of scene fields to values, got %r" % cases)
+    if problems:
+        sys.exit("sweep: %s:\n  %s" % (path, "\n  ".join(problems)))
     return spec
 
 
@@ -86,6 +102,12 @@ def run(path, jobs=None, hosts=None, out=None):
     spec = load(path)
     out = out or os.path.join(ROOT, "sweeps", os.path.splitext(os.path.basename(path))[0])
     points = list(combinations(spec))
+    ids = [run_id(point) for point in points]
+    shared = sorted({i for i in ids if ids.count(i) > 1})
+    if shared:
+        # Their runs would write one directory, each over the other's results.
+        sys.exit("sweep: %s: runs that differ only in what their directory names leave out share %s; "
+                 "shorten the values or vary fewer fields of one name" % (path, ", ".join(shared)))
     run_dirs = []
     for point in points:
         run_dir = os.path.join(out, "runs", run_id(point))

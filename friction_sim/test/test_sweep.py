@@ -83,6 +83,32 @@ class SweepTest(unittest.TestCase):
             sweep.run(os.path.join(self.work, "nonexistent.yaml"))
         self.assertIn("nonexistent.yaml cannot be read", str(missing.exception))
 
+    def test_a_sweep_file_of_the_wrong_shape_is_refused_naming_each_key(self):
+        path = os.path.join(self.work, "shapes.yaml")
+        with open(path, "w") as handle:
+            handle.write("base: friction_sim/scenes/single_block.yaml\n"
+                         "set: [stop.global_events]\n"
+                         "vary: {load.normal_force: 1000, stage.program: []}\n"
+                         "cases: {pusher.height: 0.01}\n")
+        with self.assertRaises(SystemExit) as refused:
+            sweep.run(path, out=os.path.join(self.work, "out"))
+        message = str(refused.exception)
+        for problem in ["set: expected a mapping", "vary.load.normal_force: expected a non-empty list of values, got 1000",
+                        "vary.stage.program: expected a non-empty list", "cases: expected a list of mappings"]:
+            self.assertIn(problem, message)
+        self.assertFalse(os.path.exists(os.path.join(self.work, "out")))
+
+    def test_runs_whose_directories_would_be_one_are_refused(self):
+        # Two stage programs that differ past the 40 characters a directory name keeps of a value.
+        program = '[{"mode":"velocity","speed":4.0e-4,"duration":0.001},{"mode":"hold","speed":%s}]'
+        path = os.path.join(self.work, "programs.yaml")
+        with open(path, "w") as handle:
+            yaml.safe_dump({"base": "friction_sim/scenes/single_block.yaml",
+                            "vary": {"stage.program": [program % "0", program % "0.0"]}}, handle)
+        with self.assertRaises(SystemExit) as refused:
+            sweep.run(path, out=os.path.join(self.work, "out"))
+        self.assertIn("share program=", str(refused.exception))
+
     def test_a_rerun_skips_finished_runs_and_retries_failed_ones(self):
         out = os.path.join(self.work, "out")
         path = self.write_sweep("[1000, -5]")
