@@ -61,6 +61,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=2, help="rounds of the interleaved runs (default 2)")
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error("--repeats: value %d is not allowed; allowed: an integer >= 1" % args.repeats)
     results = {label: [] for label, _, _ in RUNS}
     with tempfile.TemporaryDirectory() as work:
         for round_index in range(args.repeats):

@@ -229,9 +229,11 @@ def write(base, head, walls, steps, events, first_steps, rounds, startup_repeats
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("base", help="the earlier build's git revision")
-    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--rounds", type=int, default=3, help="rounds of the interleaved runs (default 3)")
     parser.add_argument("--rewrite", action="store_true", help="write the report from the kept measurements")
     args = parser.parse_args()
+    if args.rounds < 1:
+        parser.error("--rounds: value %d is not allowed; allowed: an integer >= 1" % args.rounds)
     if args.rewrite:
         with open(MEASURED) as handle:
             kept = json.load(handle)
