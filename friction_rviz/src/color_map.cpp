@@ -99,9 +99,9 @@ std::vector<double> fieldValues(Field field, const std::vector<float>& sigma_xx,
 
 Rgb contactColor(unsigned state) {
   switch (state) {
-    case 0:
+    case kStuck:
       return Rgb{0.15f, 0.35f, 0.95f};
-    case 1:
+    case kSliding:
       return Rgb{0.95f, 0.15f, 0.10f};
     default:
       return Rgb{0.55f, 0.55f, 0.55f};

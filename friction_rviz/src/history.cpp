@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "friction_rviz/color_map.h"
+
 namespace friction_rviz {
 
 bool SeriesHistory::add(double time, double value) {
@@ -45,7 +47,7 @@ bool SpaceTimeHistory::add(double time, const std::vector<double>& positions, co
   double x_min = 0.0, x_max = 0.0;
   bool sliding = false;
   for (std::size_t i = 0; i < states.size() && i < positions.size(); ++i) {
-    if (states[i] != 1) continue;
+    if (states[i] != kSliding) continue;
     x_min = sliding ? std::min(x_min, positions[i]) : positions[i];
     x_max = sliding ? std::max(x_max, positions[i]) : positions[i];
     sliding = true;

@@ -17,6 +17,10 @@
 
 namespace friction_rviz {
 
+static_assert(kStuck == friction_msgs::InterfaceState::STUCK && kSliding == friction_msgs::InterfaceState::SLIDING &&
+                  kDetached == friction_msgs::InterfaceState::DETACHED,
+              "color_map.h numbers the contact states as InterfaceState does");
+
 InterfaceDisplay::InterfaceDisplay() : history_(kDefaultRows) {
   rows_ = new rviz::IntProperty("History", kDefaultRows, "Frames kept in the strip (older ones scroll out).", this,
                                 SLOT(startHistoryOver()));

@@ -19,6 +19,16 @@
 
 namespace friction_rviz {
 
+static_assert(static_cast<int>(EventKind::Precursor) == friction_msgs::SlipEvent::PRECURSOR &&
+                  static_cast<int>(EventKind::SingleNodeSlip) == friction_msgs::SlipEvent::SINGLE_NODE_SLIP &&
+                  static_cast<int>(EventKind::BackSlip) == friction_msgs::SlipEvent::BACK_SLIP &&
+                  static_cast<int>(EventKind::Global) == friction_msgs::SlipEvent::GLOBAL &&
+                  static_cast<int>(EventKind::AfterGlobal) == friction_msgs::SlipEvent::AFTER_GLOBAL,
+              "EventKind numbers the kinds as SlipEvent does");
+static_assert(friction_msgs::StageState::VELOCITY == 0 && friction_msgs::StageState::HOLD == 1 &&
+                  friction_msgs::StageState::POSITION == 2,
+              "the state line names the modes by these numbers");
+
 PlotWidget::PlotWidget(const QString& x_label, const QString& y_label, QWidget* parent)
     : QWidget(parent), x_label_(x_label), y_label_(y_label) {
   setMinimumHeight(120);

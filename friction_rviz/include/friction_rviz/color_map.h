@@ -41,6 +41,10 @@ bool signedField(Field field);
 std::vector<double> fieldValues(Field field, const std::vector<float>& sigma_xx, const std::vector<float>& sigma_zz,
                                 const std::vector<float>& tau_xz, const std::vector<float>& speed);
 
+/// An interface node's contact state, numbered as friction_msgs/InterfaceState's constants (checked where
+/// the messages are read).
+constexpr unsigned kStuck = 0, kSliding = 1, kDetached = 2;
+
 /// Colour of an interface node by contact state: stuck blue, sliding red, contact lost grey.
 Rgb contactColor(unsigned state);
 
