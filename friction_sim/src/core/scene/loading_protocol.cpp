@@ -40,33 +40,27 @@ ProtocolReading readProtocolFields(const YAML::Node& root, LoadingProtocol& prot
   YamlFieldReader reader(root, problems);
   reader.list("steps", protocol.steps, [&](ProtocolStep& step) {
     const std::string where = "steps[" + std::to_string(reading.action_refused.size()) + "].";
-    auto require = [&](const char* key, const std::string& what) {
-      if (!reader.require(key, what)) reading.missing.insert(where + key);
-    };
     const std::size_t problems_before = problems.size();
     reader.field("action", step.action);
     reading.action_refused.push_back(problems.size() > problems_before);
-    // No default stands in for what a step acts with: a move_to without its target would drive the
-    // stage back to 0 and unload the slider.
-    if (!reading.action_refused.back()) {
-      if (step.action == ProtocolAction::NormalLoad) require("normal_force", "the F_Z to reach, N");
-      if (step.action == ProtocolAction::Drive || step.action == ProtocolAction::MoveTo) {
-        require("speed", "the stage's speed, m/s");
-      }
-      if (step.action == ProtocolAction::MoveTo) require("target", "the stage position to move to, m");
-    }
+    const bool known = !reading.action_refused.back();
     // Only the fields its action acts with: another (a duration on normal_load, a speed on hold) would
     // be read and ignored, while its writer expects it to act. Past a refused action, all of them.
-    const bool known = !reading.action_refused.back();
     auto uses = [&](std::initializer_list<ProtocolAction> actions) {
       return !known || std::find(actions.begin(), actions.end(), step.action) != actions.end();
     };
+    // No default stands in for what a step acts with: a move_to without its target would drive the
+    // stage back to 0 and unload the slider.
+    auto required = [&](const char* key, const std::string& what, double& value) {
+      if (known && !reader.require(key, what)) reading.missing.insert(where + key);
+      reader.field(key, value);
+    };
     if (uses({ProtocolAction::NormalLoad})) {
-      reader.field("normal_force", step.normal_force);
+      required("normal_force", "the F_Z to reach, N", step.normal_force);
       reader.field("ramp_time", step.ramp_time);
     }
-    if (uses({ProtocolAction::Drive, ProtocolAction::MoveTo})) reader.field("speed", step.speed);
-    if (uses({ProtocolAction::MoveTo})) reader.field("target", step.target);
+    if (uses({ProtocolAction::Drive, ProtocolAction::MoveTo})) required("speed", "the stage's speed, m/s", step.speed);
+    if (uses({ProtocolAction::MoveTo})) required("target", "the stage position to move to, m", step.target);
     if (uses({ProtocolAction::Hold, ProtocolAction::Drive, ProtocolAction::MoveTo})) {
       reader.field("duration", step.duration);
     }

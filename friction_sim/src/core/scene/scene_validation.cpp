@@ -312,7 +312,7 @@ void checkMemory(Checker& check, const Scene& s) {
   }
   std::ostringstream limit_text;
   limit_text.precision(3);
-  limit_text << limit / 1e9 << " GB (half this machine's memory; FRICTION_MEMORY_LIMIT_MB sets another)";
+  limit_text << limit / 1e9 << " GB (half this machine's memory; " << kMemoryLimitVariable << " sets another)";
   const bool lattice = s.model == ModelKind::Lattice2D;
   const double bytes_per_node = lattice ? 3e3 : 1e3;
   const double nodes = lattice ? static_cast<double>(s.lattice.nodes_x) * s.lattice.nodes_z : s.chain.blocks;
