@@ -29,6 +29,22 @@ static_assert(friction_msgs::StageState::VELOCITY == 0 && friction_msgs::StageSt
                   friction_msgs::StageState::POSITION == 2,
               "the state line names the modes by these numbers");
 
+namespace {
+/// The state line of the stage state `state`.
+QString stateLine(const friction_msgs::StageState& state) {
+  const char* modes[] = {"velocity", "hold", "position"};
+  return QString("stage: t = %1 s, %2, X_s = %3 mm, V = %4 mm/s, F_X = %5 N, F_Z = %6 N, global events %7%8")
+      .arg(state.header.stamp.toSec(), 0, 'f', 4)
+      .arg(modes[std::min<int>(state.mode, 2)])
+      .arg(state.position * 1e3, 0, 'f', 4)
+      .arg(state.velocity * 1e3, 0, 'f', 3)
+      .arg(state.shear_force, 0, 'f', 1)
+      .arg(state.normal_force, 0, 'f', 1)
+      .arg(state.global_events)
+      .arg(state.paused ? " (paused)" : "");
+}
+}  // namespace
+
 PlotWidget::PlotWidget(const QString& x_label, const QString& y_label, QWidget* parent)
     : QWidget(parent), x_label_(x_label), y_label_(y_label) {
   setMinimumHeight(120);
@@ -140,10 +156,16 @@ RigPanel::RigPanel(QWidget* parent) : rviz::Panel(parent) {
   layout->addWidget(precursor_plot_);
   state_label_ = new QLabel;
   // As wide as a state's line from the start: the dock, sized by it, must not change width when the first
-  // state replaces the shorter "waiting" line (the 3D view beside it would move).
-  state_label_->setMinimumWidth(state_label_->fontMetrics().horizontalAdvance(
-      "stage: t = 0.8370 s, velocity, X_s = 0.3348 mm, V = 0.400 mm/s, F_X = 261.1 N, F_Z = 1920.0 N, "
-      "global events 4"));
+  // state replaces the shorter "waiting" line (the 3D view beside it would move). A state of the default
+  // experiment's sizes.
+  friction_msgs::StageState typical;
+  typical.header.stamp.fromSec(0.837);
+  typical.position = 3.348e-4;
+  typical.velocity = 4e-4;
+  typical.shear_force = 261.1;
+  typical.normal_force = 1920.0;
+  typical.global_events = 4;
+  state_label_->setMinimumWidth(state_label_->fontMetrics().horizontalAdvance(stateLine(typical)));
   layout->addWidget(state_label_);
   auto* controls = new QGridLayout;
   speed_ = new QDoubleSpinBox;
@@ -248,18 +270,7 @@ void RigPanel::refresh() {
         QString::fromStdString("stage: waiting for " + ros::names::append(connected_namespace_, "stage_state")));
     return;
   }
-  const friction_msgs::StageState& state = *last_state_;
-  const char* modes[] = {"velocity", "hold", "position"};
-  state_label_->setText(QString("stage: t = %1 s, %2, X_s = %3 mm, V = %4 mm/s, F_X = %5 N, F_Z = %6 N, "
-                                "global events %7%8")
-                            .arg(state.header.stamp.toSec(), 0, 'f', 4)
-                            .arg(modes[std::min<int>(state.mode, 2)])
-                            .arg(state.position * 1e3, 0, 'f', 4)
-                            .arg(state.velocity * 1e3, 0, 'f', 3)
-                            .arg(state.shear_force, 0, 'f', 1)
-                            .arg(state.normal_force, 0, 'f', 1)
-                            .arg(state.global_events)
-                            .arg(state.paused ? " (paused)" : ""));
+  state_label_->setText(stateLine(*last_state_));
 }
 
 void RigPanel::send(const friction_msgs::StageCommand& command) {
