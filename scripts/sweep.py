@@ -27,6 +27,7 @@ others' results are kept. The runs' event tables are collected into
 DIR/events.csv with one column per varied parameter (DIR defaults to sweeps/<sweep file name>).
 """
 import argparse
+import collections
 import csv
 import itertools
 import os
@@ -103,14 +104,14 @@ def run(path, jobs=None, hosts=None, out=None):
     out = out or os.path.join(ROOT, "sweeps", os.path.splitext(os.path.basename(path))[0])
     points = list(combinations(spec))
     ids = [run_id(point) for point in points]
-    shared = sorted({i for i in ids if ids.count(i) > 1})
+    shared = sorted(i for i, count in collections.Counter(ids).items() if count > 1)
     if shared:
         # Their runs would write one directory, each over the other's results.
         sys.exit("sweep: %s: runs that differ only in what their directory names leave out share %s; "
                  "shorten the values or vary fewer fields of one name" % (path, ", ".join(shared)))
     run_dirs = []
-    for point in points:
-        run_dir = os.path.join(out, "runs", run_id(point))
+    for point, point_id in zip(points, ids):
+        run_dir = os.path.join(out, "runs", point_id)
         os.makedirs(run_dir, exist_ok=True)
         with open(os.path.join(run_dir, "command.sh"), "w") as handle:
             handle.write("#!/bin/sh\nexec %s\n" % command(spec, point, run_dir))

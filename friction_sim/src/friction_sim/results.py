@@ -140,14 +140,18 @@ def load(path, namespace=None, event_source="simulator"):
     if os.path.isdir(path):
         return load_folder(path)
     recording = read_bag(path, namespace, event_source, gauges=True)
-    loading = np.array(recording.loading).reshape(-1, 3)
     frames = recording.frames
-    return Run(events=event_table(recording.events),
-               loading=Table(collections.OrderedDict([("time_s", loading[:, 0]), ("shear_force_N", loading[:, 1]),
-                                                      ("normal_force_N", loading[:, 2])])),
+    return Run(events=event_table(recording.events), loading=loading_table(recording.loading),
                slip_map=SlipMap(np.array([f[0] for f in frames]), np.array(frames[0][1]),
                                 np.array([f[2] for f in frames])) if frames else None,
                gauges=recording.gauges, event_nodes=None, stresses=None, scene=recording.scene)
+
+
+def loading_table(readings):
+    """A bag's load-cell readings, (t, F_X, F_Z) each, as loading.csv's columns of them."""
+    loading = np.array(readings, dtype=float).reshape(-1, 3)
+    return Table(collections.OrderedDict([("time_s", loading[:, 0]), ("shear_force_N", loading[:, 1]),
+                                          ("normal_force_N", loading[:, 2])]))
 
 
 class BagError(Exception):
